@@ -59,11 +59,21 @@ template <class T> IBL_FUNC T ndf_ggx(const vec3<T>& h, T alpha) noexcept {
     return h.z >= T(0) && d > T(0) ? a2 / (pi_v<T> * d * d) : T(0);
 }
 
+/// The root shared by the GGX Smith terms (Lambda, G1, the height-correlated V):
+///   s(mu) = sqrt(mu^2 + alpha^2 (1 - mu^2)) = mu sqrt(1 + alpha^2 tan^2(theta)),  mu = n.w in [0, 1].
+/// Written as a sum of two non-negative terms: no cancellation anywhere, s(1) = 1 exactly (the
+/// second term is exactly 0) and s(0) = sqrt(alpha2). The textbook mu^2 (1 - alpha^2) + alpha^2
+/// rounds 1 - alpha^2 first, so its s(1) is 1 only up to rounding, and sqrt(1 + a^2 tan^2) needs
+/// tan, infinite at mu = 0. s(mu) >= max(mu, alpha) for alpha <= 1.
+/// Takes alpha2 = alpha^2 (already clamped) and mu already in [0, 1].
+template <class T> IBL_FUNC T ggx_smith_root(T mu, T alpha2) noexcept {
+    return safe_sqrt(mu * mu + alpha2 * (T(1) - mu) * (T(1) + mu));
+}
+
 /// Smith G1 for GGX from mu = n.w in [0, 1] (clamped). G1(0) = 0, G1(1) = 1.
 template <class T> IBL_FUNC T g1_smith_ggx(T n_dot_w, T alpha) noexcept {
-    const T a2 = sqr(clamp_alpha(alpha));
     const T mu = saturate(n_dot_w);
-    const T s = safe_sqrt(mu * mu + a2 * (T(1) - mu) * (T(1) + mu));
+    const T s = ggx_smith_root(mu, sqr(clamp_alpha(alpha)));
     return T(2) * mu / (mu + s); // mu + s >= alpha > 0
 }
 
@@ -72,7 +82,7 @@ template <class T> IBL_FUNC T g1_smith_ggx(T n_dot_w, T alpha) noexcept {
 template <class T> IBL_FUNC T lambda_ggx(T n_dot_w, T alpha) noexcept {
     const T a2 = sqr(clamp_alpha(alpha));
     const T mu = saturate(n_dot_w);
-    const T s = safe_sqrt(mu * mu + a2 * (T(1) - mu) * (T(1) + mu));
+    const T s = ggx_smith_root(mu, a2);
     // Lambda = (s - mu) / (2 mu) = a2 (1 - mu^2) / (2 mu (s + mu)): no cancellation for small alpha.
     const T num = a2 * (T(1) - mu) * (T(1) + mu);
     const T den = T(2) * mu * (s + mu);
