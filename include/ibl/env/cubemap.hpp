@@ -1,0 +1,368 @@
+#pragma once
+// ibl/env/cubemap.hpp — cubemap<T>: six faces with a mip chain of linear RGB, seamless filtering
+// (host only: std::vector storage, exceptions on bad input).
+//
+// Convention: env/cube_geometry.hpp (faces +X, -X, +Y, -Y, +Z, -Z; GL sc/tc/ma table; row 0 of a
+// face is t = 0, column 0 is s = 0; texel (x, y) covers [x/n, (x+1)/n] x [y/n, (y+1)/n]).
+//
+// Levels. Level 0 is the finest, of face size n (any n >= 1, power of two or not); level l has
+// size max(1, n >> l). The full chain ends at 1 x 1 (floor(log2 n) + 1 levels). Mip generation
+// is an exact box filter on the sphere: a coarse texel is the solid-angle-weighted mean of the
+// pieces of the finer texels it covers (weights: exact solid angles of the overlap rectangles,
+// from the antiderivative of cube_geometry.hpp, in double). So the integral of radiance over the
+// sphere, sum(texel * exact texel solid angle), is the same at every level up to rounding; for
+// non-power-of-two sizes a fine texel straddling two coarse texels is split between them exactly.
+//
+// Storage. Texels are interleaved vec3<T> (RGB together): one bilinear lookup reads two pairs of
+// adjacent texels, i.e. two runs of 2 x 3 scalars, which is fewer cache lines than planar RGB.
+// Every face of every level is stored with a 1-texel border, (n + 2)^2 texels, so a bilinear
+// lookup reads 4 texels with no wrap logic and no branch:
+//   * an edge border texel holds the texel of the neighbouring face that lies across the edge
+//     (the cube unfolded about that edge: the neighbour texel at the same distance from the edge);
+//   * a corner border texel, where only three texels of the cube meet, holds
+//     a + ((b - a) + (c - a)) / 3 of the three (the face's corner texel a and the two edge border
+//     texels b, c): the mean, written so that three equal values give that value exactly.
+// Consequently a bilinear lookup is continuous across every edge (both sides blend the same two
+// texels with the same weights exactly on the edge) and at the 8 corners (all three faces give
+// (a + b + c) / 3 there).
+//
+// Mutation. texel_ref()/set_texel()/fill() write the interior and mark the borders stale;
+// generate_mips() (rebuilds levels >= 1 from level 0) or update_borders() (keeps all levels) must
+// run before lookups, which assert this with IBL_ASSERT.
+//
+// Lookups (dir need not be unit, must be non-zero; the zero vector and NaN map to the centre of
+// face +X, as cube_lookup documents):
+//   bilinear(dir, level)  seamless bilinear on one level;
+//   radiance(dir, lod)    trilinear: bilinear on floor(lod) and floor(lod)+1, linear in lod
+//                         (lod continuous, clamped to [0, max_lod()], NaN -> 0);
+//   nearest(dir, lod)     texel containing dir on level round(lod).
+// Interpolation is written a + w (b - a), so equal texels give exactly that value, and texel
+// centres give the texel exactly.
+//
+// texel_solid_angle(lod): average texel solid angle 4 pi / (6 n_l^2) at integer lods, interpolated
+// log-linearly in between (= Omega_0 4^lod for power-of-two chains); lod_for_solid_angle is its
+// exact inverse. exact_texel_solid_angle(x, y, level) gives the true (non-uniform) value.
+
+#include <cmath>
+#include <cstddef>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "../core/config.hpp"
+#include "../core/constants.hpp"
+#include "../core/executor.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
+#include "cube_geometry.hpp"
+#include "detail/resample.hpp"
+#include "environment.hpp"
+
+namespace ibl {
+
+template <class T> class cubemap {
+public:
+    using scalar_type = T;
+    using value_type = vec3<T>;
+
+    /// Face size n >= 1 at level 0; levels = 0 means the full chain down to 1 x 1. Texels are 0.
+    explicit cubemap(int size, int levels = 0) {
+        if (size < 1)
+            throw std::invalid_argument("ibl::cubemap: face size must be >= 1, got " + std::to_string(size));
+        const int full = detail::full_chain_levels(size);
+        if (levels < 0 || levels > full)
+            throw std::invalid_argument("ibl::cubemap: levels must be in [0, " + std::to_string(full) +
+                                        "] for face size " + std::to_string(size) + ", got " +
+                                        std::to_string(levels));
+        if (levels == 0) levels = full;
+        std::size_t offset = 0;
+        for (int l = 0; l < levels; ++l) {
+            level_info li;
+            li.n = size >> l > 0 ? size >> l : 1;
+            li.stride = li.n + 2;
+            li.offset = offset;
+            li.omega = T(four_pi_v<double> / (6.0 * double(li.n) * double(li.n)));
+            li.log2_omega = T(std::log2(four_pi_v<double> / (6.0 * double(li.n) * double(li.n))));
+            offset += 6 * std::size_t(li.stride) * std::size_t(li.stride);
+            levels_.push_back(li);
+        }
+        data_.assign(offset, vec3<T>(T(0)));
+    }
+
+    [[nodiscard]] int size(int level = 0) const noexcept { return levels_[std::size_t(level)].n; }
+    [[nodiscard]] int levels() const noexcept { return int(levels_.size()); }
+    [[nodiscard]] T max_lod() const noexcept { return T(levels_.size() - 1); }
+    /// True when the borders match the interiors (lookups are allowed).
+    [[nodiscard]] bool borders_valid() const noexcept { return !borders_dirty_; }
+
+    // ---- texel access (interior texels, x, y in [0, size(level))) ---------------------------
+
+    [[nodiscard]] const vec3<T>& texel(int face, int x, int y, int level = 0) const noexcept {
+        return data_[index(face, x, y, level)];
+    }
+    /// Writable texel; marks the borders stale (call generate_mips() or update_borders()).
+    [[nodiscard]] vec3<T>& texel_ref(int face, int x, int y, int level = 0) noexcept {
+        borders_dirty_ = true;
+        return data_[index(face, x, y, level)];
+    }
+    void set_texel(int face, int x, int y, int level, const vec3<T>& v) noexcept { texel_ref(face, x, y, level) = v; }
+
+    /// Sets every texel of a level to fn(face, x, y); marks the borders stale.
+    template <class F> void fill(int level, F&& fn) {
+        const int n = size(level);
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) data_[index(f, x, y, level)] = vec3<T>(fn(f, x, y));
+        borders_dirty_ = true;
+    }
+
+    /// Exact solid angle (steradians) of texel (x, y) of a level (the same on every face).
+    [[nodiscard]] T exact_texel_solid_angle(int x, int y, int level = 0) const noexcept {
+        return T(cube_texel_solid_angle<double>(x, y, size(level)));
+    }
+
+    // ---- environment concept ----------------------------------------------------------------
+
+    /// Average texel solid angle at a continuous lod (see the header comment).
+    [[nodiscard]] T texel_solid_angle(T lod) const noexcept {
+        const T l = clamp(lod, T(0), max_lod());
+        const int l0 = int(l);
+        const T f = l - T(l0);
+        if (!(f > T(0))) return levels_[std::size_t(l0)].omega;
+        const T a = levels_[std::size_t(l0)].log2_omega, b = levels_[std::size_t(l0) + 1].log2_omega;
+        return std::exp2(a + f * (b - a));
+    }
+
+    /// The lod whose average texel solid angle is omega, clamped to [0, max_lod()]; 0 for NaN.
+    [[nodiscard]] T lod_for_solid_angle(T omega) const noexcept {
+        if (!(omega > levels_[0].omega)) return T(0);
+        const T x = std::log2(omega);
+        for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
+            const T a = levels_[l].log2_omega, b = levels_[l + 1].log2_omega;
+            if (x <= b) return T(l) + (x - a) / (b - a);
+        }
+        return max_lod();
+    }
+
+    /// Trilinear radiance (seamless bilinear on two levels, linear in the continuous lod).
+    [[nodiscard]] vec3<T> radiance(const vec3<T>& dir, T lod = T(0)) const noexcept {
+        IBL_ASSERT(!borders_dirty_);
+        const cube_coord<T> c = cube_lookup(dir);
+        const T l = clamp(lod, T(0), max_lod());
+        const int l0 = int(l);
+        const T f = l - T(l0);
+        vec3<T> v = bilinear_unchecked(c.face, c.s, c.t, l0);
+        if (f > T(0)) v += f * (bilinear_unchecked(c.face, c.s, c.t, l0 + 1) - v);
+        return v;
+    }
+
+    /// Seamless bilinear lookup on one level (level clamped to the chain).
+    [[nodiscard]] vec3<T> bilinear(const vec3<T>& dir, int level = 0) const noexcept {
+        IBL_ASSERT(!borders_dirty_);
+        const cube_coord<T> c = cube_lookup(dir);
+        return bilinear_unchecked(c.face, c.s, c.t, clamp_level(level));
+    }
+
+    /// Seamless bilinear lookup at face texture coordinates (s, t), clamped to [0, 1].
+    [[nodiscard]] vec3<T> bilinear(int face, T s, T t, int level = 0) const noexcept {
+        IBL_ASSERT(!borders_dirty_ && face >= 0 && face < 6);
+        return bilinear_unchecked(face, clamp(s, T(0), T(1)), clamp(t, T(0), T(1)), clamp_level(level));
+    }
+
+    /// Texel containing dir on level round(lod) (lod clamped to [0, max_lod()], NaN -> 0).
+    [[nodiscard]] vec3<T> nearest(const vec3<T>& dir, T lod = T(0)) const noexcept {
+        const cube_coord<T> c = cube_lookup(dir);
+        const int l = int(clamp(lod, T(0), max_lod()) + T(0.5));
+        const int n = size(l);
+        const int x = min_int(int(c.s * T(n)), n - 1);
+        const int y = min_int(int(c.t * T(n)), n - 1);
+        return data_[index(c.face, x, y, l)];
+    }
+
+    // ---- building -----------------------------------------------------------------------------
+
+    /// Rebuilds levels 1.. from level 0 by the exact spherical box filter, then all borders.
+    /// Work is spread over coarse rows through the executor; the result does not depend on it.
+    template <class Executor = serial_executor> void generate_mips(Executor&& ex = Executor{}) {
+        for (int l = 1; l < levels(); ++l) downsample(l, ex);
+        update_borders();
+    }
+
+    /// Rebuilds the 1-texel borders of every face of every level from the interiors.
+    void update_borders() {
+        for (int l = 0; l < levels(); ++l) build_borders(l);
+        borders_dirty_ = false;
+    }
+
+    /// Replaces non-finite components (and negative ones when zero_negative) of every texel of
+    /// every level by 0, then rebuilds the borders. Returns the number of texels changed.
+    /// Run it before generate_mips() so that bad level-0 texels do not spread into the mips.
+    std::size_t sanitize(bool zero_negative = true) {
+        std::size_t changed = 0;
+        for (int l = 0; l < levels(); ++l) {
+            const int n = size(l);
+            for (int f = 0; f < 6; ++f)
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x) {
+                        vec3<T>& v = data_[index(f, x, y, l)];
+                        bool bad = false;
+                        for (int k = 0; k < 3; ++k) {
+                            if (!is_finite(v[k]) || (zero_negative && v[k] < T(0))) {
+                                v[k] = T(0);
+                                bad = true;
+                            }
+                        }
+                        changed += bad ? 1 : 0;
+                    }
+        }
+        update_borders();
+        return changed;
+    }
+
+private:
+    struct level_info {
+        int n = 1;               ///< face size
+        int stride = 3;          ///< n + 2 (row length including the border)
+        std::size_t offset = 0;  ///< index of the first stored texel of face 0 (with border)
+        T omega = T(0);          ///< average texel solid angle 4 pi / (6 n^2)
+        T log2_omega = T(0);
+    };
+
+    static int min_int(int a, int b) noexcept { return a < b ? a : b; }
+    int clamp_level(int level) const noexcept {
+        return level < 0 ? 0 : (level >= levels() ? levels() - 1 : level);
+    }
+
+    /// Storage index of (face, x, y) with x, y in [-1, n] (border included).
+    std::size_t index(int face, int x, int y, int level) const noexcept {
+        const level_info& li = levels_[std::size_t(level)];
+        IBL_ASSERT(face >= 0 && face < 6 && x >= -1 && x <= li.n && y >= -1 && y <= li.n);
+        const std::size_t st = std::size_t(li.stride);
+        return li.offset + std::size_t(face) * st * st + std::size_t(y + 1) * st + std::size_t(x + 1);
+    }
+
+    /// Bilinear on one level; s, t in [0, 1] (up to rounding), level valid. Texel centre x sits
+    /// at bordered coordinate x + 1, so the bordered coordinate of s is s n + 0.5 in [0.5, n + 0.5].
+    vec3<T> bilinear_unchecked(int face, T s, T t, int level) const noexcept {
+        const level_info& li = levels_[std::size_t(level)];
+        const T fx = s * T(li.n) + T(0.5);
+        const T fy = t * T(li.n) + T(0.5);
+        const int x0 = min_int(int(fx), li.n); // fx >= 0: truncation is floor
+        const int y0 = min_int(int(fy), li.n);
+        const T wx = fx - T(x0);
+        const T wy = fy - T(y0);
+        const std::size_t st = std::size_t(li.stride);
+        const vec3<T>* p = data_.data() + li.offset + std::size_t(face) * st * st + std::size_t(y0) * st +
+                           std::size_t(x0);
+        const vec3<T> top = p[0] + wx * (p[1] - p[0]);
+        const vec3<T> bot = p[st] + wx * (p[st + 1] - p[st]);
+        return top + wy * (bot - top);
+    }
+
+    /// Face texel across the edge from border texel (x, y) of `face` (exactly one of x, y is
+    /// outside [0, n)). The border texel centre is a point of the face plane just beyond the edge;
+    /// folding the cube about the edge moves it onto the neighbour face at the same distance from
+    /// the edge. Integer coordinates scaled by n keep this exact.
+    static void fold_border(int face, int x, int y, int n, int& g, int& gx, int& gy) noexcept {
+        const double a = double(2 * x + 1 - n), b = double(2 * y + 1 - n), dn = double(n);
+        const vec3<double> ma = cube_face_point<double>(face, 0.0, 0.0);
+        const vec3<double> sa = cube_face_point<double>(face, 1.0, 0.0) - ma;
+        const vec3<double> ta = cube_face_point<double>(face, 0.0, 1.0) - ma;
+        vec3<double> p = dn * ma + a * sa + b * ta; // components are integers, |overflow| = n + 1
+        for (int k = 0; k < 3; ++k) {
+            if (std::fabs(p[k]) > dn) {
+                p[k] = std::copysign(dn, p[k]);
+                for (int j = 0; j < 3; ++j)
+                    if (ma[j] != 0.0) p[j] = ma[j] * (dn - 1.0);
+                break;
+            }
+        }
+        const cube_coord<double> c = cube_lookup(p);
+        g = c.face;
+        gx = min_int(int(c.s * dn), n - 1); // s n sits at a texel centre (integer + 0.5)
+        gy = min_int(int(c.t * dn), n - 1);
+    }
+
+    void build_borders(int level) {
+        const int n = size(level);
+        for (int f = 0; f < 6; ++f) {
+            for (int i = 0; i < n; ++i) {
+                const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
+                for (int e = 0; e < 4; ++e) {
+                    int g, gx, gy;
+                    fold_border(f, xs[e], ys[e], n, g, gx, gy);
+                    data_[index(f, xs[e], ys[e], level)] = data_[index(g, gx, gy, level)];
+                }
+            }
+            const int cx[2] = {-1, n}, ix[2] = {0, n - 1};
+            for (int u = 0; u < 2; ++u)
+                for (int v = 0; v < 2; ++v) {
+                    const vec3<T> a = data_[index(f, ix[u], ix[v], level)];
+                    const vec3<T> b = data_[index(f, cx[u], ix[v], level)];
+                    const vec3<T> c = data_[index(f, ix[u], cx[v], level)];
+                    data_[index(f, cx[u], cx[v], level)] = a + ((b - a) + (c - a)) / T(3);
+                }
+        }
+    }
+
+    /// Level `level` from level - 1: per coarse texel, sum over overlap pieces of
+    /// w (fine - ref) in double with w the exact piece solid angle and ref the first fine texel,
+    /// then ref + sum / sum(w). (The shift by ref makes a constant region exact.)
+    template <class Executor> void downsample(int level, Executor& ex) {
+        const int n = size(level - 1), m = size(level);
+        const std::vector<detail::grid_piece> pieces = detail::grid_overlap(n, m);
+        const auto ranges = detail::coarse_ranges(pieces, m);
+        const std::size_t k_count = pieces.size();
+        std::vector<double> bound(k_count + 1); // x (and y) boundaries in face coordinates [-1, 1]
+        bound[0] = 2.0 * pieces[0].lo - 1.0;
+        for (std::size_t k = 0; k < k_count; ++k) bound[k + 1] = 2.0 * pieces[k].hi - 1.0;
+
+        ex(std::size_t(m), [&](std::size_t row_begin, std::size_t row_end) {
+            std::vector<double> f_lo(k_count + 1), f_hi(k_count + 1);
+            std::vector<vec3<double>> acc(static_cast<std::size_t>(6 * m)), ref(static_cast<std::size_t>(6 * m));
+            std::vector<double> wsum(static_cast<std::size_t>(m));
+            for (std::size_t cy = row_begin; cy < row_end; ++cy) {
+                const auto [yb, ye] = ranges[cy];
+                for (int f = 0; f < 6; ++f)
+                    for (int cx = 0; cx < m; ++cx) {
+                        const auto& first = pieces[std::size_t(ranges[std::size_t(cx)].first)];
+                        ref[std::size_t(f * m + cx)] =
+                            vec3<double>(data_[index(f, first.fine, pieces[std::size_t(yb)].fine, level - 1)]);
+                        acc[std::size_t(f * m + cx)] = vec3<double>(0.0);
+                    }
+                std::fill(wsum.begin(), wsum.end(), 0.0);
+                for (std::size_t k = 0; k <= k_count; ++k)
+                    f_lo[k] = detail::cube_area_antiderivative(bound[k], bound[std::size_t(yb)]);
+                for (int yk = yb; yk < ye; ++yk) {
+                    const int fy = pieces[std::size_t(yk)].fine;
+                    for (std::size_t k = 0; k <= k_count; ++k)
+                        f_hi[k] = detail::cube_area_antiderivative(bound[k], bound[std::size_t(yk) + 1]);
+                    for (std::size_t k = 0; k < k_count; ++k) {
+                        const double w = (f_hi[k + 1] - f_hi[k]) - (f_lo[k + 1] - f_lo[k]);
+                        const int cx = pieces[k].coarse, fx = pieces[k].fine;
+                        wsum[std::size_t(cx)] += w;
+                        for (int f = 0; f < 6; ++f) {
+                            const std::size_t j = std::size_t(f * m + cx);
+                            acc[j] += w * (vec3<double>(data_[index(f, fx, fy, level - 1)]) - ref[j]);
+                        }
+                    }
+                    std::swap(f_lo, f_hi);
+                }
+                for (int f = 0; f < 6; ++f)
+                    for (int cx = 0; cx < m; ++cx) {
+                        const std::size_t j = std::size_t(f * m + cx);
+                        data_[index(f, cx, int(cy), level)] = vec3<T>(ref[j] + acc[j] / wsum[std::size_t(cx)]);
+                    }
+            }
+        });
+    }
+
+    std::vector<level_info> levels_;
+    std::vector<vec3<T>> data_;
+    bool borders_dirty_ = false;
+};
+
+static_assert(environment<cubemap<float>, float>);
+static_assert(environment<cubemap<double>, double>);
+
+} // namespace ibl
