@@ -154,6 +154,33 @@ TEST_CASE("cubemap: exact texel solid angles sum to 4 pi at every level") {
     }
 }
 
+TEST_CASE_TEMPLATE("cubemap: branch-free face selection equals cube_lookup bit for bit", T, float, double) {
+    dir_gen g;
+    std::vector<v3<T>> dirs;
+    for (int i = 0; i < 2000; ++i) dirs.push_back(g.next<T>() * T(1 + i % 7)); // not unit either
+    for (int i = 0; i < 27; ++i) // every tie: axes, edges, corners, with signed zeros
+        for (T z : {T(0), T(-0.0)}) {
+            const T c[3] = {T(i % 3 - 1), T((i / 3) % 3 - 1), T(i / 9 - 1)};
+            if (c[0] == 0 && c[1] == 0 && c[2] == 0) continue;
+            dirs.push_back(v3<T>(c[0] == 0 ? z : c[0], c[1] == 0 ? z : c[1], c[2] == 0 ? z : c[2]));
+        }
+    for (const auto& d : dirs) {
+        const auto a = ibl::cube_lookup(d), b = ibl::detail::cube_lookup_select(d);
+        CHECK(a.face == b.face);
+        CHECK(a.s == b.s);
+        CHECK(a.t == b.t);
+    }
+    const auto z = ibl::detail::cube_lookup_select(v3<T>(0));
+    CHECK((z.face == 0 && z.s == T(0.5) && z.t == T(0.5)));
+    // Bad directions read a valid texel (no out-of-bounds access, finite result).
+    const ibl::cubemap<T> c = ibl::bake_cubemap<T>(ibl::constant_environment<T>{v3<T>(2)}, 4, 1);
+    const T nan = std::numeric_limits<T>::quiet_NaN(), inf = std::numeric_limits<T>::infinity();
+    for (const v3<T>& d : {v3<T>(nan, 0, 1), v3<T>(inf, 1, 0), v3<T>(0, -inf, nan), v3<T>(0)}) {
+        CHECK(c.radiance(d, T(0.5)) == v3<T>(2));
+        CHECK(c.nearest(d) == v3<T>(2));
+    }
+}
+
 TEST_CASE_TEMPLATE("cubemap: constant environment is reproduced exactly everywhere", T, float, double) {
     // Every stage is written ref + w (x - ref) (bake, mips, corner borders, bilinear, trilinear),
     // so equal inputs give that input bit for bit: the tolerance is 0.

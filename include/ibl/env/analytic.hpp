@@ -115,9 +115,11 @@ template <class T> struct sky_environment {
 };
 
 /// The default environment of the bake tool: a blue sky over a dark ground with a sun at 30
-/// degrees elevation (azimuth 40 degrees from +X towards +Z, i.e. off every cube axis and plane),
-/// angular radius 1 degree, radiance 3e4 times the mean sky (a cap of 9.6e-4 sr: the sun's
-/// irradiance on a normal facing it is about 10x the sky's on an upward normal, as outdoors).
+/// degrees elevation (azimuth 40 degrees from +X towards +Z, so off every cube axis, edge and
+/// face diagonal), angular radius 1 degree (a cap of 9.57e-4 sr), radiance 3e4 (about 4e4 times
+/// the horizon radiance, 1.5e5 times the ground). Its irradiance on a normal facing it,
+/// 3e4 pi sin^2(1 deg) = 28.7, is about 20 times the sky's on an upward normal (1.0 to 2.6 per
+/// channel), the ratio of a clear day.
 template <class T> sky_environment<T> make_default_sky() noexcept {
     sky_environment<T> s;
     const T elev = T(30) * pi_v<T> / T(180), az = T(40) * pi_v<T> / T(180);

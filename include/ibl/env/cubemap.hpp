@@ -30,8 +30,11 @@
 // generate_mips() (rebuilds levels >= 1 from level 0) or update_borders() (keeps all levels) must
 // run before lookups, which assert this with IBL_ASSERT.
 //
-// Lookups (dir need not be unit, must be non-zero; the zero vector and NaN map to the centre of
-// face +X, as cube_lookup documents):
+// Lookups (dir need not be unit; the zero vector maps to the centre of face +X as cube_lookup
+// documents, and NaN/inf components to some texel of face +X, never out of bounds). Face
+// selection uses detail::cube_lookup_select: cube_lookup written with selects instead of
+// branches (bit-identical results for finite non-zero directions), because directions that jump
+// between faces mispredict cube_lookup's branches.
 //   bilinear(dir, level)  seamless bilinear on one level;
 //   radiance(dir, lod)    trilinear: bilinear on floor(lod) and floor(lod)+1, linear in lod
 //                         (lod continuous, clamped to [0, max_lod()], NaN -> 0);
@@ -45,6 +48,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -59,6 +63,33 @@
 #include "environment.hpp"
 
 namespace ibl {
+
+namespace detail {
+/// cube_lookup without data-dependent branches (selects only): the same face, s and t bit for
+/// bit, including the X-before-Y-before-Z tie rule and the zero/NaN fallback. Random directions
+/// make the branches of cube_lookup mispredict (~19 ns against ~2.5 ns for coherent ones).
+template <class T> IBL_FUNC cube_coord<T> cube_lookup_select(const vec3<T>& r) noexcept {
+    using std::fabs;
+    const T ax = fabs(r.x), ay = fabs(r.y), az = fabs(r.z);
+    const bool xm = (ax >= ay) & (ax >= az); // & not &&: no short-circuit branch
+    const bool ym = (!xm) & (ay >= az);
+    // 0/1 weights instead of ternaries: compilers keep these as arithmetic (ternaries on floats
+    // were turned back into branches). Exact: the unselected terms are +-0.
+    const T wx = T(xm), wy = T(ym), wz = T(1) - wx - wy;
+    const T ma = wx * ax + wy * ay + wz * az;
+    const T major = wx * r.x + wy * r.y + wz * r.z;
+    const bool neg = !(major >= T(0));
+    const T sg = T(1) - T(2) * T(neg);
+    //        +-X: sc = -+z, tc = -y;  +-Y: sc = x, tc = +-z;  +-Z: sc = +-x, tc = -y
+    const T sc = wx * (-sg * r.z) + wy * r.x + wz * (sg * r.x);
+    const T tc = wy * (sg * r.z) - (T(1) - wy) * r.y;
+    const int face = 2 * (int(!xm) + int((!xm) & (!ym))) + int(neg);
+    const bool ok = (ma > T(0)) & (ma <= std::numeric_limits<T>::max()); // zero, NaN, inf: fallback
+    const T inv = T(1) / (ma + T(!ok));
+    // A bad direction gives face 0 and s, t = 0.5 or NaN (0 * inf); callers clamp (NaN -> 0).
+    return {face * int(ok), T(0.5) * (T(ok) * (sc * inv) + T(1)), T(0.5) * (T(ok) * (tc * inv) + T(1))};
+}
+} // namespace detail
 
 template <class T> class cubemap {
 public:
@@ -147,7 +178,7 @@ public:
     /// Trilinear radiance (seamless bilinear on two levels, linear in the continuous lod).
     [[nodiscard]] vec3<T> radiance(const vec3<T>& dir, T lod = T(0)) const noexcept {
         IBL_ASSERT(!borders_dirty_);
-        const cube_coord<T> c = cube_lookup(dir);
+        const cube_coord<T> c = face_coord(dir);
         const T l = clamp(lod, T(0), max_lod());
         const int l0 = int(l);
         const T f = l - T(l0);
@@ -159,7 +190,7 @@ public:
     /// Seamless bilinear lookup on one level (level clamped to the chain).
     [[nodiscard]] vec3<T> bilinear(const vec3<T>& dir, int level = 0) const noexcept {
         IBL_ASSERT(!borders_dirty_);
-        const cube_coord<T> c = cube_lookup(dir);
+        const cube_coord<T> c = face_coord(dir);
         return bilinear_unchecked(c.face, c.s, c.t, clamp_level(level));
     }
 
@@ -171,7 +202,7 @@ public:
 
     /// Texel containing dir on level round(lod) (lod clamped to [0, max_lod()], NaN -> 0).
     [[nodiscard]] vec3<T> nearest(const vec3<T>& dir, T lod = T(0)) const noexcept {
-        const cube_coord<T> c = cube_lookup(dir);
+        const cube_coord<T> c = face_coord(dir);
         const int l = int(clamp(lod, T(0), max_lod()) + T(0.5));
         const int n = size(l);
         const int x = min_int(int(c.s * T(n)), n - 1);
@@ -229,6 +260,13 @@ private:
     };
 
     static int min_int(int a, int b) noexcept { return a < b ? a : b; }
+    /// Face and (s, t) clamped to [0, 1] (NaN -> 0: bad directions read a valid texel).
+    static cube_coord<T> face_coord(const vec3<T>& dir) noexcept {
+        cube_coord<T> c = detail::cube_lookup_select(dir);
+        c.s = clamp(c.s, T(0), T(1));
+        c.t = clamp(c.t, T(0), T(1));
+        return c;
+    }
     int clamp_level(int level) const noexcept {
         return level < 0 ? 0 : (level >= levels() ? levels() - 1 : level);
     }
