@@ -21,12 +21,17 @@ template <class T> IBL_FUNC constexpr T pow5(T x) noexcept {
 /// Clamp to [0, 1]. NaN maps to 0 (both comparisons are false), so a NaN cosine or roughness
 /// never propagates through a saturate.
 template <class T> IBL_FUNC constexpr T saturate(T x) noexcept {
-    return x > T(0) ? (x < T(1) ? x : T(1)) : T(0);
+    // Two sequential two-way selects rather than a nested ternary: the same values (NaN -> 0),
+    // but g++ if-converts only two-way selects in loops it has not been told to vectorise, so
+    // this keeps the batch kernels' lane loops branch-free and vectorised.
+    const T y = x > T(0) ? x : T(0);
+    return y < T(1) ? y : T(1);
 }
 
 /// Clamp to [lo, hi]; NaN maps to lo.
 template <class T> IBL_FUNC constexpr T clamp(T x, T lo, T hi) noexcept {
-    return x > lo ? (x < hi ? x : hi) : lo;
+    const T y = x > lo ? x : lo; // sequential two-way selects: see saturate
+    return y < hi ? y : hi;
 }
 
 /// Linear interpolation a + t (b - a), exact at t = 0 and t = 1.

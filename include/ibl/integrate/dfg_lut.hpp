@@ -1,0 +1,137 @@
+#pragma once
+// ibl/integrate/dfg_lut.hpp — the DFG look-up table: generation (exact or Monte Carlo) through the
+// batch kernels and an executor, layout, and bilinear lookup (host only).
+//
+// Layout (float32, interleaved channels, row-major):
+//   texel (i, j), i, j in [0, size):  x = n.v = (i + 0.5) / size,  y = r = (j + 0.5) / size
+//   (texel centres: r = 0 and n.v = 0 themselves are half a texel outside, as in a GPU texture
+//   sampled with clamp-to-edge). Row j holds one roughness; row 0 (r = 0.5 / size) comes first in
+//   memory, so data[(j * size + i) * channels + c]. Uploaded as is, row 0 is the texture's
+//   first row (v = 0 in GL/Vulkan/D3D texel addressing), so a shader samples at (n.v, r).
+//   channel 0 = A (scale of F0), 1 = B (bias, scale of F90), 2 (optional) = k = (1 - E)/E,
+//   E = A + B: Turquin's multiple-scattering compensation (integrate/dfg_multiscatter.hpp).
+//
+// Work: rows are independent and go through the executor (core/executor.hpp); within a row the
+// batch kernels take W texels at a time (W = 8 doubles for the quadrature, 16 floats for Monte
+// Carlo), the remainder at W = 1. Which texels share a kernel call depends only on size, never on
+// the executor, so the table is bit-identical for every partition and thread count.
+
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "../batch/dfg_kernel.hpp"
+#include "../core/executor.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
+#include "dfg.hpp"
+#include "dfg_multiscatter.hpp"
+
+namespace ibl {
+
+struct dfg_lut {
+    std::uint32_t size = 0;     ///< texels per side
+    std::uint32_t channels = 0; ///< 2 (A, B) or 3 (A, B, k)
+    std::vector<float> data;    ///< (j * size + i) * channels + c
+
+    /// n.v at the centre of column i.
+    double n_dot_v(std::uint32_t i) const noexcept { return (double(i) + 0.5) / double(size); }
+    /// Roughness at the centre of row j.
+    double roughness(std::uint32_t j) const noexcept { return (double(j) + 0.5) / double(size); }
+    float at(std::uint32_t i, std::uint32_t j, std::uint32_t c) const noexcept {
+        return data[(std::size_t(j) * size + i) * channels + c];
+    }
+    /// Bilinear lookup at (n.v, r) with clamp-to-edge, as a GPU sampler does (channel 2 is 0 for a
+    /// two-channel table).
+    vec3<float> sample(float n_dot_v, float rough) const noexcept {
+        const float fx = clamp(n_dot_v * float(size) - 0.5f, 0.0f, float(size - 1));
+        const float fy = clamp(rough * float(size) - 0.5f, 0.0f, float(size - 1));
+        const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
+        const std::uint32_t i1 = i0 + 1 < size ? i0 + 1 : i0, j1 = j0 + 1 < size ? j0 + 1 : j0;
+        const float tx = fx - float(i0), ty = fy - float(j0);
+        vec3<float> out(0.0f);
+        for (std::uint32_t c = 0; c < channels && c < 3; ++c) {
+            const float top = lerp(at(i0, j0, c), at(i1, j0, c), tx);
+            const float bottom = lerp(at(i0, j1, c), at(i1, j1, c), tx);
+            out[int(c)] = lerp(top, bottom, ty);
+        }
+        return out;
+    }
+};
+
+/// Node counts used for tables (weights evaluated in float, see dfg_quadrature_lanes): largest
+/// error of the 128^2 float table 4.8e-6 (height-correlated) / 4.2e-6 (Schlick k_IBL) against a
+/// converged double reference, both in the first column (bench/bench_dfg.cpp), inside the 1e-5
+/// target, at 432 weight evaluations per texel. {16, 16, 32, 16} gives 4e-7 at 1.8x the cost.
+inline constexpr dfg_quadrature_nodes dfg_lut_default_nodes{12, 12, 24, 12};
+
+namespace detail {
+template <class T> void dfg_store(dfg_lut& lut, std::uint32_t i, std::uint32_t j, double e, double b) {
+    float* p = &lut.data[(std::size_t(j) * lut.size + i) * lut.channels];
+    p[0] = float(e - b);
+    p[1] = float(b);
+    if (lut.channels > 2) p[2] = float(dfg_energy_compensation(e));
+}
+} // namespace detail
+
+/// The exact table of model M (quadrature in double), channels 2 or 3.
+template <class Model, class Executor = thread_executor>
+dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_quadrature_nodes nodes = dfg_lut_default_nodes,
+                           Executor&& ex = Executor{}) {
+    constexpr std::size_t W = 16;
+    dfg_lut lut{size, channels < 3 ? 2u : 3u, {}};
+    lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
+    const dfg_quadrature_rule rule(nodes);
+    const dfg_quadrature_view q = rule.view();
+    ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) {
+            const double r = lut.roughness(std::uint32_t(j));
+            std::uint32_t i = 0;
+            for (; i + W <= size; i += W) {
+                double mu[W], e[W], b[W];
+                for (std::size_t l = 0; l < W; ++l) mu[l] = lut.n_dot_v(i + std::uint32_t(l));
+                dfg_quadrature_lanes<Model, W, float>(q, r, mu, e, b);
+                for (std::size_t l = 0; l < W; ++l) detail::dfg_store<double>(lut, i + std::uint32_t(l), std::uint32_t(j), e[l], b[l]);
+            }
+            for (; i < size; ++i) {
+                const double mu = lut.n_dot_v(i);
+                double e, b;
+                dfg_quadrature_lanes<Model, 1, float>(q, r, &mu, &e, &b);
+                detail::dfg_store<double>(lut, i, std::uint32_t(j), e, b);
+            }
+        }
+    });
+    return lut;
+}
+
+/// The Monte Carlo table of model M: `samples` Hammersley points with GGX-NDF sampling per texel
+/// (the literature's estimator, float), one sample table per row shared by its texels.
+/// Channels 2 or 3 (k from the Monte Carlo E).
+template <class Model, class Executor = thread_executor>
+dfg_lut make_dfg_lut_mc(std::uint32_t size, std::uint32_t samples, std::uint32_t channels = 2, Executor&& ex = Executor{}) {
+    constexpr std::size_t W = 16;
+    dfg_lut lut{size, channels < 3 ? 2u : 3u, {}};
+    lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
+    ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
+        for (std::size_t j = begin; j < end; ++j) {
+            const float r = float(lut.roughness(std::uint32_t(j)));
+            const dfg_sample_table<float> tab = make_dfg_sample_table(Model::alpha(r), samples);
+            std::uint32_t i = 0;
+            for (; i + W <= size; i += W) {
+                float mu[W], e[W], b[W];
+                for (std::size_t l = 0; l < W; ++l) mu[l] = float(lut.n_dot_v(i + std::uint32_t(l)));
+                dfg_mc_lanes<Model, W>(tab.hx.data(), tab.hz.data(), samples, r, mu, e, b);
+                for (std::size_t l = 0; l < W; ++l) detail::dfg_store<float>(lut, i + std::uint32_t(l), std::uint32_t(j), e[l], b[l]);
+            }
+            for (; i < size; ++i) {
+                const float mu = float(lut.n_dot_v(i));
+                float e, b;
+                dfg_mc_lanes<Model, 1>(tab.hx.data(), tab.hz.data(), samples, r, &mu, &e, &b);
+                detail::dfg_store<float>(lut, i, std::uint32_t(j), e, b);
+            }
+        }
+    });
+    return lut;
+}
+
+} // namespace ibl
