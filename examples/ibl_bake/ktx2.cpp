@@ -1,0 +1,309 @@
+// examples/ibl_bake/ktx2.cpp — KTX2 cubemap writer and validating reader (layout: ktx2.hpp).
+
+#include "ktx2.hpp"
+
+#include <bit>
+#include <cstring>
+#include <limits>
+#include <string_view>
+
+#include "image_io.hpp"
+
+namespace ibl_bake {
+namespace {
+
+constexpr unsigned char ktx2_identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
+constexpr std::size_t header_bytes = 80;
+constexpr std::size_t level_entry_bytes = 24;
+constexpr std::uint32_t dfd_block_bytes = 24 + 16 * 4;
+constexpr std::uint32_t dfd_total_bytes = 4 + dfd_block_bytes;
+constexpr std::uint32_t khr_df_model_rgbsda = 1, khr_df_primaries_bt709 = 1, khr_df_transfer_linear = 1;
+constexpr std::uint32_t khr_df_version_1_3 = 2;
+constexpr std::uint32_t khr_df_qualifier_float_signed = 0x80 | 0x40;
+constexpr std::uint32_t float_minus_one_bits = 0xBF800000u, float_one_bits = 0x3F800000u;
+
+int full_chain(int n) {
+    int levels = 1;
+    while ((n >> levels) > 0) ++levels;
+    return levels;
+}
+
+std::size_t texel_bytes(ktx2_format f) { return f == ktx2_format::rgba32f ? 16 : 8; }
+
+std::size_t align_up(std::size_t x, std::size_t a) { return (x + a - 1) / a * a; }
+
+void put32(std::vector<unsigned char>& b, std::size_t at, std::uint32_t v) {
+    for (int i = 0; i < 4; ++i) b[at + std::size_t(i)] = static_cast<unsigned char>(v >> (8 * i));
+}
+void put64(std::vector<unsigned char>& b, std::size_t at, std::uint64_t v) {
+    for (int i = 0; i < 8; ++i) b[at + std::size_t(i)] = static_cast<unsigned char>(v >> (8 * i));
+}
+std::uint32_t get32(std::span<const unsigned char> b, std::size_t at) {
+    std::uint32_t v = 0;
+    for (int i = 3; i >= 0; --i) v = (v << 8) | b[at + std::size_t(i)];
+    return v;
+}
+std::uint64_t get64(std::span<const unsigned char> b, std::size_t at) {
+    return std::uint64_t(get32(b, at)) | (std::uint64_t(get32(b, at + 4)) << 32);
+}
+
+void check_cube(const cubemap_rgb32f& c, const std::string& name) {
+    if (c.size < 1) throw image_error(name, "cubemap face size must be >= 1, got " + std::to_string(c.size));
+    if (c.size > 65536) throw image_error(name, "cubemap face size " + std::to_string(c.size) + " too large");
+    const int L = int(c.levels.size());
+    if (L < 1 || L > full_chain(c.size))
+        throw image_error(name, "cubemap of face size " + std::to_string(c.size) + " cannot have " + std::to_string(L) +
+                                    " mip levels (1 to " + std::to_string(full_chain(c.size)) + ")");
+    for (int l = 0; l < L; ++l) {
+        const std::size_t s = std::size_t(c.face_size(l));
+        for (int f = 0; f < 6; ++f)
+            if (c.levels[std::size_t(l)][std::size_t(f)].size() != s * s * 3)
+                throw image_error(name, "cubemap level " + std::to_string(l) + " face " + std::to_string(f) + " has " +
+                                            std::to_string(c.levels[std::size_t(l)][std::size_t(f)].size()) +
+                                            " values, expected " + std::to_string(s * s * 3));
+    }
+}
+
+} // namespace
+
+// ---- half floats -------------------------------------------------------------------------------
+
+std::uint16_t float_to_half(float f) noexcept {
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(f);
+    const std::uint16_t sign = static_cast<std::uint16_t>((bits >> 16) & 0x8000u);
+    const std::uint32_t a = bits & 0x7fffffffu;
+    if (a > 0x7f800000u) return static_cast<std::uint16_t>(sign | 0x7e00u); // NaN (quiet)
+    if (a == 0x7f800000u) return static_cast<std::uint16_t>(sign | 0x7c00u); // infinity
+    if (a >= 0x477fe000u) return static_cast<std::uint16_t>(sign | 0x7bffu); // >= 65504: clamp
+    const int e = int(a >> 23) - 127;
+    const std::uint32_t m24 = (a & 0x7fffffu) | 0x800000u;
+    std::uint32_t h, rem, halfway;
+    if (e >= -14) { // normal half: 10 mantissa bits, drop 13
+        h = (std::uint32_t(e + 15) << 10) | ((a & 0x7fffffu) >> 13);
+        rem = a & 0x1fffu;
+        halfway = 0x1000u;
+    } else { // subnormal half: value / 2^-24 = m24 * 2^(e + 1)
+        const int s = -(e + 1); // >= 14
+        if (s >= 25) return sign;
+        h = m24 >> s;
+        rem = m24 & ((1u << s) - 1u);
+        halfway = 1u << (s - 1);
+    }
+    if (rem > halfway || (rem == halfway && (h & 1u))) ++h; // may carry into the exponent: correct
+    return static_cast<std::uint16_t>(sign | h);
+}
+
+float half_to_float(std::uint16_t h) noexcept {
+    const std::uint32_t sign = std::uint32_t(h & 0x8000u) << 16;
+    const std::uint32_t e = (h >> 10) & 0x1fu;
+    const std::uint32_t m = h & 0x3ffu;
+    if (e == 0x1f) return std::bit_cast<float>(sign | 0x7f800000u | (m << 13));
+    if (e == 0) { // zero or subnormal: m * 2^-24, exact in float
+        const float v = float(m) * 0x1p-24f;
+        return sign ? -v : v;
+    }
+    return std::bit_cast<float>(sign | ((e + 112) << 23) | (m << 13));
+}
+
+// ---- writer ------------------------------------------------------------------------------------
+
+cubemap_rgb32f cubemap_rgb32f::zeros(int size, int level_count) {
+    cubemap_rgb32f c;
+    c.size = size;
+    c.levels.resize(std::size_t(level_count > 0 ? level_count : 0));
+    for (int l = 0; l < level_count; ++l) {
+        const std::size_t s = std::size_t(c.face_size(l));
+        for (auto& face : c.levels[std::size_t(l)]) face.assign(s * s * 3, 0.0f);
+    }
+    return c;
+}
+
+std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
+                                               const std::string& name) {
+    check_cube(cube, name);
+    const std::size_t L = cube.levels.size();
+    const std::size_t tb = texel_bytes(format);
+    const std::size_t dfd_offset = header_bytes + level_entry_bytes * L;
+    const std::size_t kvd_offset = dfd_offset + dfd_total_bytes;
+    const std::string key = "KTXwriter";
+    const std::size_t kv_len = key.size() + 1 + writer.size() + 1;
+    const std::size_t kvd_length = align_up(4 + kv_len, 4);
+    std::size_t pos = kvd_offset + kvd_length;
+
+    // Level placement, smallest level first.
+    std::vector<std::size_t> offset(L), length(L);
+    for (std::size_t i = L; i-- > 0;) {
+        const std::size_t s = std::size_t(cube.face_size(int(i)));
+        pos = align_up(pos, tb); // lcm(texel size, 4) = texel size for 8 and 16
+        offset[i] = pos;
+        length[i] = 6 * s * s * tb;
+        pos += length[i];
+    }
+    std::vector<unsigned char> b(pos, 0);
+
+    std::memcpy(b.data(), ktx2_identifier, sizeof ktx2_identifier);
+    put32(b, 12, std::uint32_t(format));
+    put32(b, 16, format == ktx2_format::rgba32f ? 4 : 2);
+    put32(b, 20, std::uint32_t(cube.size));
+    put32(b, 24, std::uint32_t(cube.size));
+    put32(b, 28, 0); // pixelDepth
+    put32(b, 32, 0); // layerCount
+    put32(b, 36, 6); // faceCount
+    put32(b, 40, std::uint32_t(L));
+    put32(b, 44, 0); // supercompressionScheme
+    put32(b, 48, std::uint32_t(dfd_offset));
+    put32(b, 52, dfd_total_bytes);
+    put32(b, 56, std::uint32_t(kvd_offset));
+    put32(b, 60, std::uint32_t(kvd_length));
+    put64(b, 64, 0); // sgdByteOffset
+    put64(b, 72, 0); // sgdByteLength
+    for (std::size_t l = 0; l < L; ++l) {
+        const std::size_t at = header_bytes + level_entry_bytes * l;
+        put64(b, at, offset[l]);
+        put64(b, at + 8, length[l]);
+        put64(b, at + 16, length[l]);
+    }
+
+    // Data format descriptor.
+    std::size_t d = dfd_offset;
+    put32(b, d, dfd_total_bytes);
+    put32(b, d + 4, 0); // vendorId 0 (Khronos), descriptorType 0 (basic)
+    put32(b, d + 8, khr_df_version_1_3 | (dfd_block_bytes << 16));
+    put32(b, d + 12, khr_df_model_rgbsda | (khr_df_primaries_bt709 << 8) | (khr_df_transfer_linear << 16));
+    put32(b, d + 16, 0);                  // texelBlockDimension0..3 = 0 (1 texel)
+    put32(b, d + 20, std::uint32_t(tb));  // bytesPlane0
+    put32(b, d + 24, 0);                  // bytesPlane4..7
+    const std::uint32_t bits = std::uint32_t(tb / 4 * 8);
+    const std::uint32_t channel_ids[4] = {0, 1, 2, 15};
+    for (std::uint32_t c = 0; c < 4; ++c) {
+        const std::size_t s = d + 28 + 16 * c;
+        put32(b, s, (bits * c) | ((bits - 1) << 16) | ((channel_ids[c] | khr_df_qualifier_float_signed) << 24));
+        put32(b, s + 4, 0); // samplePosition
+        put32(b, s + 8, float_minus_one_bits);
+        put32(b, s + 12, float_one_bits);
+    }
+
+    // Key/value data.
+    put32(b, kvd_offset, std::uint32_t(kv_len));
+    std::memcpy(b.data() + kvd_offset + 4, key.c_str(), key.size() + 1);
+    std::memcpy(b.data() + kvd_offset + 4 + key.size() + 1, writer.c_str(), writer.size() + 1);
+
+    // Texels.
+    for (std::size_t l = 0; l < L; ++l) {
+        const std::size_t s = std::size_t(cube.face_size(int(l)));
+        std::size_t at = offset[l];
+        for (std::size_t f = 0; f < 6; ++f) {
+            const std::vector<float>& src = cube.levels[l][f];
+            for (std::size_t t = 0; t < s * s; ++t) {
+                const float px[4] = {src[3 * t], src[3 * t + 1], src[3 * t + 2], 1.0f};
+                for (int c = 0; c < 4; ++c) {
+                    if (format == ktx2_format::rgba32f) {
+                        put32(b, at, std::bit_cast<std::uint32_t>(px[c]));
+                        at += 4;
+                    } else {
+                        const std::uint16_t h = float_to_half(px[c]);
+                        b[at] = static_cast<unsigned char>(h & 0xff);
+                        b[at + 1] = static_cast<unsigned char>(h >> 8);
+                        at += 2;
+                    }
+                }
+            }
+        }
+    }
+    return b;
+}
+
+void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format,
+                        const std::string& writer) {
+    write_file_atomic(path, encode_ktx2_cubemap(cube, format, writer, path));
+}
+
+// ---- reader ------------------------------------------------------------------------------------
+
+ktx2_info parse_ktx2(std::span<const unsigned char> b, const std::string& name) {
+    const auto bad = [&](const std::string& what) { return image_error(name, "invalid KTX2 file: " + what); };
+    if (b.size() < header_bytes) throw bad("truncated header (" + std::to_string(b.size()) + " bytes)");
+    if (std::memcmp(b.data(), ktx2_identifier, sizeof ktx2_identifier) != 0) throw bad("wrong identifier");
+    ktx2_info k;
+    k.vk_format = get32(b, 12);
+    k.type_size = get32(b, 16);
+    k.pixel_width = get32(b, 20);
+    k.pixel_height = get32(b, 24);
+    k.pixel_depth = get32(b, 28);
+    k.layer_count = get32(b, 32);
+    k.face_count = get32(b, 36);
+    k.level_count = get32(b, 40);
+    k.supercompression = get32(b, 44);
+    k.dfd_offset = get32(b, 48);
+    k.dfd_length = get32(b, 52);
+    k.kvd_offset = get32(b, 56);
+    k.kvd_length = get32(b, 60);
+    k.sgd_offset = get64(b, 64);
+    k.sgd_length = get64(b, 72);
+    const std::uint64_t n = b.size();
+    const std::uint32_t levels = k.level_count == 0 ? 1 : k.level_count;
+    if (levels > 32) throw bad("levelCount " + std::to_string(k.level_count) + " > 32");
+    if (header_bytes + level_entry_bytes * levels > n) throw bad("truncated level index");
+    const auto in_bounds = [&](std::uint64_t off, std::uint64_t len) { return off <= n && len <= n - off; };
+    if (!in_bounds(k.dfd_offset, k.dfd_length) || k.dfd_length < 4 || k.dfd_offset % 4 || k.dfd_length % 4)
+        throw bad("data format descriptor out of bounds or misaligned");
+    if (!in_bounds(k.kvd_offset, k.kvd_length)) throw bad("key/value data out of bounds");
+    if (!in_bounds(k.sgd_offset, k.sgd_length)) throw bad("supercompression global data out of bounds");
+    for (std::uint32_t l = 0; l < levels; ++l) {
+        const std::size_t at = header_bytes + level_entry_bytes * l;
+        ktx2_level lv{get64(b, at), get64(b, at + 8), get64(b, at + 16)};
+        if (!in_bounds(lv.byte_offset, lv.byte_length)) throw bad("level " + std::to_string(l) + " out of bounds");
+        k.levels.push_back(lv);
+    }
+    for (std::uint32_t i = 0; i < k.dfd_length / 4; ++i) k.dfd.push_back(get32(b, k.dfd_offset + 4 * i));
+    if (k.dfd[0] != k.dfd_length) throw bad("dfdTotalSize differs from dfdByteLength");
+    // Key/value pairs: {u32 length, key\0value, padding to 4}.
+    std::uint64_t p = k.kvd_offset;
+    const std::uint64_t kv_end = std::uint64_t(k.kvd_offset) + k.kvd_length;
+    while (p + 4 <= kv_end) {
+        const std::uint32_t len = get32(b, std::size_t(p));
+        if (len > kv_end - p - 4) throw bad("key/value entry overruns the key/value data");
+        const char* s = reinterpret_cast<const char*>(b.data() + p + 4);
+        const std::string_view entry(s, len);
+        const std::size_t nul = entry.find('\0');
+        if (nul == std::string_view::npos) throw bad("key without terminating NUL");
+        std::string value(entry.substr(nul + 1));
+        if (!value.empty() && value.back() == '\0') value.pop_back();
+        k.key_values.emplace_back(std::string(entry.substr(0, nul)), value);
+        p = align_up(std::size_t(p + 4 + len), 4);
+    }
+    return k;
+}
+
+cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::string& name) {
+    const ktx2_info k = parse_ktx2(b, name);
+    const auto bad = [&](const std::string& what) { return image_error(name, "unsupported KTX2 cubemap: " + what); };
+    if (k.vk_format != std::uint32_t(ktx2_format::rgba32f) && k.vk_format != std::uint32_t(ktx2_format::rgba16f))
+        throw bad("vkFormat " + std::to_string(k.vk_format));
+    if (k.supercompression != 0) throw bad("supercompressed");
+    if (k.face_count != 6 || k.layer_count != 0 || k.pixel_depth != 0) throw bad("not a single cubemap");
+    if (k.pixel_width != k.pixel_height || k.pixel_width < 1 || k.pixel_width > 65536) throw bad("faces not square");
+    const ktx2_format fmt = ktx2_format(k.vk_format);
+    const std::size_t tb = texel_bytes(fmt);
+    cubemap_rgb32f c = cubemap_rgb32f::zeros(int(k.pixel_width), int(k.levels.size()));
+    if (int(k.levels.size()) > full_chain(c.size)) throw bad("more levels than the face size allows");
+    for (std::size_t l = 0; l < k.levels.size(); ++l) {
+        const std::size_t s = std::size_t(c.face_size(int(l)));
+        if (k.levels[l].byte_length != 6 * s * s * tb || k.levels[l].byte_offset % tb)
+            throw bad("level " + std::to_string(l) + " has the wrong size or alignment");
+        std::size_t at = std::size_t(k.levels[l].byte_offset);
+        for (std::size_t f = 0; f < 6; ++f)
+            for (std::size_t t = 0; t < s * s; ++t) {
+                for (std::size_t ch = 0; ch < 3; ++ch) {
+                    c.levels[l][f][3 * t + ch] =
+                        fmt == ktx2_format::rgba32f
+                            ? std::bit_cast<float>(get32(b, at + 4 * ch))
+                            : half_to_float(static_cast<std::uint16_t>(b[at + 2 * ch] | (b[at + 2 * ch + 1] << 8)));
+                }
+                at += tb;
+            }
+    }
+    return c;
+}
+
+} // namespace ibl_bake

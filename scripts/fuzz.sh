@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# scripts/fuzz.sh [RUNS] — build the libFuzzer harness of the ibl-bake image readers
+# (examples/ibl_bake/fuzz) with clang++ -fsanitize=fuzzer,address,undefined and run it for RUNS
+# executions (default 100000), one job, on a seed corpus made from the real test EXRs and small
+# valid HDR/EXR/KTX2/PNG files. Not part of the default test run. Crash reproducers land in
+# build/fuzz/artifacts/; copy them to examples/ibl_bake/tests/data/fuzz-<name> as regression
+# inputs once fixed. tinyexr is compiled from Debian's header (IBL_BAKE_TINYEXR_IMPLEMENTATION,
+# zlib) so that its code is instrumented too.
+set -euo pipefail
+RUNS=${1:-100000}
+ROOT=$(cd "$(dirname "$0")/.." && pwd)
+SRC=$ROOT/examples/ibl_bake
+OUT=$ROOT/build/fuzz
+CXX=${CXX_FUZZ:-clang++}
+mkdir -p "$OUT/corpus" "$OUT/artifacts" "$OUT/seeds"
+COMMON=(-std=c++20 -g -O1 -fno-omit-frame-pointer -I"$SRC" -isystem /usr/include/stb -DIBL_BAKE_TINYEXR_IMPLEMENTATION)
+SAN=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
+
+echo "== building (clang: $($CXX --version | head -1))"
+"$CXX" "${COMMON[@]}" "${SAN[@]}" -fsanitize=fuzzer \
+    "$SRC/fuzz/fuzz_image_readers.cpp" "$SRC/image_io.cpp" "$SRC/ktx2.cpp" -lz -o "$OUT/fuzz_image_readers"
+"$CXX" "${COMMON[@]}" "$SRC/fuzz/make_seeds.cpp" "$SRC/image_io.cpp" "$SRC/ktx2.cpp" -lz -o "$OUT/make_seeds"
+
+echo "== seed corpus"
+"$OUT/make_seeds" "$OUT/seeds"
+cp "$ROOT"/tests/data/*.exr "$OUT/seeds/"
+find "$SRC/tests/data" -name 'fuzz-*' -exec cp {} "$OUT/seeds/" \; 2>/dev/null || true
+ls -l "$OUT/seeds"
+
+echo "== fuzzing: $RUNS executions, one job"
+export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
+export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
+START=$(date +%s)
+"$OUT/fuzz_image_readers" "$OUT/corpus" "$OUT/seeds" \
+    -runs="$RUNS" -max_len=65536 -timeout=10 -rss_limit_mb=2048 -jobs=1 -workers=1 \
+    -artifact_prefix="$OUT/artifacts/" -print_final_stats=1 2>&1 | tee "$OUT/fuzz.log" | grep -E '^#|INFO|ERROR|SUMMARY|stat::|Done' | tail -40
+STATUS=${PIPESTATUS[0]}
+END=$(date +%s)
+echo "== fuzz exit status $STATUS, $((END - START)) s wall; artifacts:"
+ls -l "$OUT/artifacts"
+exit "$STATUS"
