@@ -140,23 +140,48 @@ template <class T> IBL_FUNC T ggx_ndf_reflected_pdf(const vec3<T>& v, const vec3
 
 /// Visible normal h for the view direction v (Dupuy & Benyoub 2023, spherical caps).
 /// Domain: unit v in tangent space with v.z in [0, 1] (v.z = 0, grazing, included; v.z < 0 is
-/// clamped to 0), u in [0, 1)^2 (phi from u.x, cap height from u.y), alpha in [0, 1] (clamped;
-/// alpha <= 0 returns (0, 0, 1) exactly). Range: unit vectors with h.z > 0. Density
-/// ggx_vndf_pdf(v, h, alpha) per unit solid angle of h.
+/// clamped to 0), u in [0, 1)^2 (cap azimuth from u.x, cap height from u.y), alpha in [0, 1]
+/// (clamped; alpha <= 0 returns (0, 0, 1) exactly). Range: unit vectors with h.z > 0 and
+/// v.h >= 0. Density ggx_vndf_pdf(v, h, alpha) per unit solid angle of h.
+///
+/// The cap azimuth is measured from -v_s (psi = 2 pi (u.x - 1/2), exact subtraction), in the
+/// frame e1 = v_s,xy / rho, e2 = z x e1 (rho = |v_s,xy|), because h_s = c + v_s vanishes at the
+/// cap point c = -v_s (u.y -> 1, psi -> 0): there both components of h_s are formed without
+/// cancellation,
+///   h_s . e1 = (rho - sin_c) + 2 sin_c sin^2(psi/2),
+///       rho - sin_c = (1 + v_s.z) (1 - u.y) ((1 - u.y) - v_s.z (1 + u.y)) / (rho + sin_c),
+///   h_s . e2 = -sin_c sin(psi),    h_s . z = (1 - u.y)(1 + v_s.z),
+/// so h keeps its relative accuracy up to the corner u = (1/2, 1 - eps/2). That corner maps to
+/// the support edge (v.h -> 0, where the density vanishes): there v.h is ~eps^2 in exact
+/// arithmetic and its computed value is the rounding noise of h, |v.h| <= a few eps.
 template <class T> IBL_FUNC vec3<T> sample_ggx_vndf(const vec3<T>& v, const vec2<T>& u, T alpha) noexcept {
-    using std::cos;
     using std::sin;
+    using std::sqrt;
     if (detail::ggx_sampling_is_mirror(alpha)) return vec3<T>(T(0), T(0), T(1));
     const T a = clamp_alpha(alpha);
     const vec3<T> vs = detail::ggx_stretch_view(v, a);
-    const T one_plus_vz = T(1) + vs.z;                              // in [1, 2]
-    const T one_minus_vz = (vs.x * vs.x + vs.y * vs.y) / one_plus_vz; // 1 - vs.z, no cancellation
-    const T w = T(1) - u.y;                                          // in (0, 1]
+    const T rho2 = vs.x * vs.x + vs.y * vs.y;
+    const T rho = sqrt(rho2);
+    // Azimuth of v_s; at normal view (rho = 0) any unit vector, +x.
+    const T e1x = rho > T(0) ? vs.x / rho : T(1);
+    const T e1y = rho > T(0) ? vs.y / rho : T(0);
+    const T one_plus_vz = T(1) + vs.z;       // in [1, 2]
+    const T one_minus_vz = rho2 / one_plus_vz; // 1 - vs.z, no cancellation
+    const T w = T(1) - u.y;                    // in (0, 1]
     // Cap point c: 1 - c.z = u.y (1 + vs.z), 1 + c.z = (1 - vs.z) + w (1 + vs.z).
     const T sin_c = safe_sqrt(u.y * one_plus_vz * (one_minus_vz + w * one_plus_vz));
-    const T phi = two_pi_v<T> * u.x;
-    // h_s = c + vs; its z component c.z + vs.z = w (1 + vs.z) > 0.
-    const vec3<T> hs(sin_c * cos(phi) + vs.x, sin_c * sin(phi) + vs.y, w * one_plus_vz);
+    const T den = rho + sin_c;
+    // q = (1 - vs.z) - u.y (1 + vs.z) = w - vs.z (1 + u.y). Towards grazing view the second form
+    // (exact at vs.z = 0, where the first would subtract |vs|^2 ~ 1 +- eps from u.y ~ 1); towards
+    // normal view the first (accurate for small u.y, where the second subtracts two numbers ~ 1).
+    // Either cancels only where q is far from the corner's q, with absolute error ~eps.
+    const T q = vs.z < T(0.5) ? w - vs.z * (T(1) + u.y) : one_minus_vz - u.y * one_plus_vz;
+    const T rho_minus_sin_c = den > T(0) ? one_plus_vz * w * q / den : T(0);
+    const T psi = two_pi_v<T> * (u.x - T(0.5));
+    const T s_half = sin(T(0.5) * psi);
+    const T x1 = rho_minus_sin_c + T(2) * sin_c * s_half * s_half; // h_s . e1
+    const T x2 = -sin_c * sin(psi);                                  // h_s . e2
+    const vec3<T> hs(x1 * e1x - x2 * e1y, x1 * e1y + x2 * e1x, w * one_plus_vz);
     return detail::normalize_scaled(vec3<T>(a * hs.x, a * hs.y, hs.z));
 }
 
@@ -178,16 +203,25 @@ template <class T> IBL_FUNC T ggx_vndf_reflected_pdf(const vec3<T>& v, const vec
 
 /// Inverse of sample_ggx_vndf: unstretch h to h_s = normalize(h.x, h.y, alpha h.z) (the same
 /// direction as (h.x/alpha, h.y/alpha, h.z)), recover the cap point c = 2 (h_s . v_s) h_s - v_s,
-/// then u.x = phi_c / (2 pi), u.y = (1 - c.z) / (1 + v_s.z). Domain: v as sample_ggx_vndf, unit h
-/// with h.z > 0 and v.h > 0 (the support), alpha in (0, 1] (clamped; at alpha = 0 the sampler is
-/// not invertible and the clamped alpha is used). Range: [0, 1)^2.
+/// then u.y = (1 - c.z) / (1 + v_s.z) and u.x = 1/2 + psi / (2 pi), psi the azimuth of c measured
+/// from -v_s (see sample_ggx_vndf). Domain: v as sample_ggx_vndf, unit h with h.z > 0 and
+/// v.h > 0 (the support), alpha in (0, 1] (clamped; at alpha = 0 the sampler is not invertible and
+/// the clamped alpha is used). Range: [0, 1)^2.
 template <class T> IBL_FUNC vec2<T> invert_ggx_vndf(const vec3<T>& v, const vec3<T>& h, T alpha) noexcept {
+    using std::atan2;
+    using std::sqrt;
     const T a = clamp_alpha(alpha);
     const vec3<T> vs = detail::ggx_stretch_view(v, a);
+    const T rho = sqrt(vs.x * vs.x + vs.y * vs.y);
+    const T e1x = rho > T(0) ? vs.x / rho : T(1);
+    const T e1y = rho > T(0) ? vs.y / rho : T(0);
     const vec3<T> hs = detail::normalize_scaled(vec3<T>(h.x, h.y, a * h.z));
     const vec3<T> c = (T(2) * glm::dot(hs, vs)) * hs - vs;
     const T uy = saturate((T(1) - c.z) / (T(1) + vs.z));
-    return vec2<T>(detail::unit_from_azimuth(c.y, c.x), uy < T(1) ? uy : one_minus_epsilon_v<T>);
+    // psi = the azimuth of c measured from -v_s, in (-pi, pi]: the angle of (-c.e1, -c.e2).
+    const T psi = atan2(c.x * e1y - c.y * e1x, -(c.x * e1x + c.y * e1y));
+    const T ux = saturate(T(0.5) + psi * inv_two_pi_v<T>);
+    return vec2<T>(ux < T(1) ? ux : T(0), uy < T(1) ? uy : one_minus_epsilon_v<T>); // psi = pi is u.x = 0
 }
 
 } // namespace ibl

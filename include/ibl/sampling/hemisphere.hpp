@@ -112,10 +112,11 @@ template <class T> IBL_FUNC vec3<T> sample_uniform_hemisphere(const vec2<T>& u) 
 /// Density of sample_uniform_hemisphere: 1 / (2 pi) per unit solid angle on z >= 0.
 template <class T> IBL_FUNC constexpr T uniform_hemisphere_pdf() noexcept { return inv_two_pi_v<T>; }
 
-/// Inverse of sample_uniform_hemisphere. Domain: unit w with w.z >= 0. Range: [0, 1)^2
-/// (w.z is clamped to [0, 1]; u.x = 1 only at the pole itself).
+/// Inverse of sample_uniform_hemisphere. Domain: unit w with w.z >= 0. Range: [0, 1)^2 (w.z is
+/// clamped to [0, 1 - eps/2]: the pole itself, z = 1, is the limit u.x -> 1).
 template <class T> IBL_FUNC vec2<T> invert_uniform_hemisphere(const vec3<T>& w) noexcept {
-    return vec2<T>(saturate(w.z), detail::unit_from_azimuth(w.y, w.x));
+    const T ux = saturate(w.z);
+    return vec2<T>(ux < T(1) ? ux : one_minus_epsilon_v<T>, detail::unit_from_azimuth(w.y, w.x));
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -124,7 +125,7 @@ template <class T> IBL_FUNC vec2<T> invert_uniform_hemisphere(const vec3<T>& w) 
 
 /// Cosine-weighted direction: the concentric disk point lifted to the hemisphere,
 /// z = sqrt(1 - r^2) = sqrt((1 - r)(1 + r)) with the exact square-ring radius r. Domain:
-/// u in [0, 1)^2. Range: unit vectors with z in [0, 1]. Density cosine_hemisphere_pdf(z) =
+/// u in [0, 1]^2 (the closed square, as the disk map). Range: unit vectors with z in [0, 1]. Density cosine_hemisphere_pdf(z) =
 /// z / pi per unit solid angle. Shirley & Chiu 1997; Malley's method.
 template <class T> IBL_FUNC vec3<T> sample_cosine_hemisphere(const vec2<T>& u) noexcept {
     const vec2<T> d = sample_concentric_disk(u);
