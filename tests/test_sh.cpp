@@ -3,6 +3,8 @@
 #include <doctest/doctest.h>
 
 #include <ibl/core/executor.hpp>
+#include <ibl/env/cubemap.hpp>
+#include <ibl/env/latlong.hpp>
 #include <ibl/sh.hpp>
 
 #include <glm/mat3x3.hpp>
@@ -413,6 +415,23 @@ TEST_CASE_TEMPLATE("sh projection: environments with a radiance(dir, lod) member
     };
     const auto c = ibl::project_function<3, T>(sky{}, 0);
     CHECK(c[0].x == doctest::Approx(2 * std::sqrt(ibl::pi_v<double>)).epsilon(8 * eps<T>()));
+}
+
+TEST_CASE("sh projection: ibl::cubemap and ibl::latlong overloads == the fetch overloads") {
+    std::mt19937 g(14);
+    const auto c = random_coeffs<float, 3>(g);
+    auto f = [&](const vec3<float>& d) { return ibl::sh_evaluate(c, d); };
+    ibl::cubemap<float> cube(16, 1);
+    cube.fill(0, [&](int face, int x, int y) { return f(ibl::cube_texel_direction<float>(face, x, y, 16)); });
+    const auto a = ibl::project_cube<3>(cube);
+    const auto b = ibl::project_cube<3>(16, cube_sampler<float>(16, f));
+    CHECK(std::memcmp(&a, &b, sizeof a) == 0); // same texels, same kernel: bit-identical
+    ibl::latlong<float> ll(32, 16, 1);
+    auto ls = latlong_sampler<float>(32, 16, f);
+    ll.fill(0, [&](int x, int y) { return ls(x, y); });
+    const auto la = ibl::project_latlong<3>(ll, ibl::thread_executor{2});
+    const auto lb = ibl::project_latlong<3>(32, 16, ls);
+    CHECK(std::memcmp(&la, &lb, sizeof la) == 0);
 }
 
 TEST_CASE("sh projection: bit-identical for every thread count") {

@@ -30,6 +30,8 @@
 //                                         in double), direction = texel centre.
 //   project_cube(cube, ex, level)         any type with cube.size(level) and
 //                                         cube.texel(face, x, y, level) -> vec3<T> (ibl::cubemap).
+//   project_latlong(img, ex, level)       any type with img.width(level), img.height(level) and
+//                                         img.texel(x, y, level) -> vec3<T> (ibl::latlong).
 //   project_latlong(W, H, fetch, ex)      fetch(x, y) -> vec3<T>; u = 0.5 + atan2(z, x)/(2pi),
 //                                         v = 0.5 + asin(y)/pi, row 0 = +Y (row j covers v from
 //                                         1 - j/H down to 1 - (j+1)/H); weight = exact row solid
@@ -342,6 +344,21 @@ auto project_latlong(int width, int height, Fetch&& fetch, Executor&& ex = {}) {
                                                 return a;
                                             });
     return acc.template result<T>();
+}
+
+/// Projection of level `level` of a lat-long image object with the accessor interface
+///   img.width(level), img.height(level) -> int, img.texel(x, y, level) -> vec3<T>
+/// (ibl::latlong<T> satisfies it; same orientation as the fetch overload).
+template <int B, class Image, class Executor = serial_executor>
+    requires requires(const Image& img) {
+        { img.width(0) } -> std::convertible_to<int>;
+        { img.height(0) } -> std::convertible_to<int>;
+        img.texel(0, 0, 0);
+    }
+auto project_latlong(const Image& img, Executor&& ex = {}, int level = 0) {
+    return project_latlong<B>(
+        int(img.width(level)), int(img.height(level)), [&](int x, int y) { return img.texel(x, y, level); },
+        std::forward<Executor>(ex));
 }
 
 /// Node counts of project_function's quadrature for a given `degree` (see the header comment).
