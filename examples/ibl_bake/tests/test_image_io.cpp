@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 #include <string>
@@ -69,18 +70,49 @@ std::vector<unsigned char> bytes_of(const std::string& s) { return {s.begin(), s
 
 } // namespace
 
-TEST_CASE("image_io: the shared DWAB-compressed EXRs are refused with a precise message") {
-    // tests/data/{studio,courtyard}.exr use DWAB compression (lossy DCT, attribute value 9),
-    // which tinyexr 1.0.1 cannot decode. The reader names the compression, the file and the
-    // remedy instead of tinyexr's "Unknown compression type".
-    for (const char* f : {"studio.exr", "courtyard.exr"}) {
-        const std::string path = data_dir + "/" + f;
-        const std::string msg = error_of([&] { (void)read_latlong(path); });
-        CAPTURE(msg);
-        CHECK(contains(msg, path));
-        CHECK(contains(msg, "DWAB"));
-        CHECK(contains(msg, "not supported"));
+TEST_CASE("image_io: the shared real environments load with the documented texel policy") {
+    // tests/data/README.md: the ZIP re-encodes hold the originals' half values bit for bit; their
+    // extremes and negative-texel counts were measured with OpenEXR on the originals. Half floats
+    // convert to float exactly, so the comparisons are exact.
+    struct expected {
+        const char* file;
+        float max;
+        std::size_t negative_texels;
+        float most_negative;
+    };
+    for (const expected& e : {expected{"studio.exr", 118.375f, 3, -3.03984e-06f},
+                              expected{"courtyard.exr", 55.5625f, 1188, -0.00318527f}}) {
+        CAPTURE(e.file);
+        read_report r;
+        const image_rgb32f img = read_latlong(data_dir + "/" + e.file, {}, &r);
+        CHECK(r.format == "OpenEXR");
+        REQUIRE(img.width == 1024);
+        REQUIRE(img.height == 512);
+        CHECK(*std::max_element(img.rgb.begin(), img.rgb.end()) == e.max);
+        CHECK(*std::min_element(img.rgb.begin(), img.rgb.end()) == 0.0f); // negatives clamped
+        CHECK(r.negative_texels == e.negative_texels);
+        CHECK(r.most_negative == doctest::Approx(e.most_negative).epsilon(1e-5)); // printed to 6 digits
+        CHECK(r.nonfinite_values == 0);
     }
+}
+
+TEST_CASE("image_io: DWA-compressed EXRs are refused with a precise message") {
+    // tinyexr 1.0.1 cannot decode DWAA/DWAB (attribute values 8, 9). Patch the compression
+    // attribute of a real ZIP file to DWAB: the reader must name the compression and the remedy
+    // instead of tinyexr's "Unknown compression type".
+    std::ifstream in(data_dir + "/studio.exr", std::ios::binary);
+    std::vector<unsigned char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key("compression\0compression\0", 24);
+    auto it = std::search(bytes.begin(), bytes.end(), key.begin(), key.end());
+    REQUIRE(it != bytes.end());
+    const std::size_t value_at = std::size_t(it - bytes.begin()) + key.size() + 4; // after the int32 size
+    REQUIRE(value_at < bytes.size());
+    bytes[value_at] = 9; // DWAB
+    const std::string msg = error_of([&] { (void)read_image_memory(bytes, "patched.exr"); });
+    CAPTURE(msg);
+    CHECK(contains(msg, "patched.exr"));
+    CHECK(contains(msg, "DWAB"));
+    CHECK(contains(msg, "not supported"));
 }
 
 TEST_CASE("image_io: OpenEXR float32 round trip is bit-exact (memory and file)") {
