@@ -199,6 +199,14 @@ struct uniform_rng {
         else
             return T(bits >> 11) * T(0x1p-53);
     }
+    /// Two variates in a fixed order (the order of evaluation of function arguments is
+    /// unspecified, so rng.next() twice in one call would differ between compilers).
+    template <class V> V next2() {
+        using T = typename V::value_type;
+        const T a = next<T>();
+        const T b = next<T>();
+        return V(a, b);
+    }
 };
 
 } // namespace ibl_test

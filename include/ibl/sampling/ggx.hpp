@@ -73,11 +73,11 @@ template <class T> IBL_FUNC vec3<T> ggx_stretch_view(const vec3<T>& v, T alpha) 
 
 /// G1(v) / (n.v) for GGX in the finite closed form 2 / (mu + sqrt(mu^2 + alpha^2 (1 - mu^2))),
 /// mu = n.v clamped to [0, 1]; equals 2/alpha at mu = 0 and 1 at mu = 1 (Heitz 2014, eq. 72
-/// divided by mu). alpha is clamped with clamp_alpha, so the value is at most 2/ggx_min_alpha_v.
+/// divided by mu; the root is brdf/ggx.hpp's ggx_smith_root). alpha is clamped with clamp_alpha,
+/// so the value is at most 2/ggx_min_alpha_v.
 template <class T> IBL_FUNC T ggx_g1_over_n_dot_v(T n_dot_v, T alpha) noexcept {
-    const T a2 = sqr(clamp_alpha(alpha));
     const T mu = saturate(n_dot_v);
-    return T(2) / (mu + safe_sqrt(mu * mu + a2 * (T(1) - mu) * (T(1) + mu)));
+    return T(2) / (mu + ggx_smith_root(mu, sqr(clamp_alpha(alpha)))); // mu + root >= alpha > 0
 }
 
 // ---------------------------------------------------------------------------------------------
