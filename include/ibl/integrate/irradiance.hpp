@@ -1,0 +1,143 @@
+#pragma once
+// ibl/integrate/irradiance.hpp — diffuse irradiance of an environment (host only).
+//
+// Convention: the library's irradiance is E (W/m^2-like), not E / pi:
+//     E(n) = integral over the hemisphere around n of L(l) max(n.l, 0) dl
+// so a constant environment L gives E = pi L, and a Lambertian surface of albedo rho reflects
+// radiance rho E / pi (brdf/lambert.hpp: f = rho / pi). (LearnOpenGL's irradiance map stores
+// E / pi and its shader multiplies by albedo without the 1/pi; to match it divide these by pi.)
+//
+// Two estimators, each a sample table in tangent space (z = n) for integrate/sphere_convolve.hpp:
+//
+//  * riemann (the literature: LearnOpenGL's irradiance convolution). In spherical coordinates
+//        E = integral_0^{2 pi} integral_0^{pi/2} L cos(theta) sin(theta) dtheta dphi,
+//    a midpoint rule with n_theta x n_phi nodes theta_i = (i + 1/2) dtheta, phi_j = (j + 1/2) dphi,
+//    dtheta = (pi/2) / n_theta, dphi = 2 pi / n_phi:
+//        E ~ dtheta dphi sum L cos sin = (pi^2 / (n_theta n_phi)) sum_ij L(theta_i, phi_j) cos sin.
+//    (LearnOpenGL writes pi * (1 / N) * sum, which is this divided by pi: E / pi.) The rule is not
+//    normalised: for a constant L it gives pi L times the midpoint rule's factor for
+//    integral sin cos dtheta, 1 + dtheta^2 / 6 + O(dtheta^4) (the phi sum is exact), i.e.
+//    a relative excess of 1.0e-4 at n_theta = 64 (the literature's sampleDelta = 0.025 has
+//    n_theta = 63, n_phi = 252).
+//  * cosine_importance: directions with density cos(theta) / pi (sampling/hemisphere.hpp,
+//    Malley's method on the concentric disk, Hammersley points), so L cos / pdf = pi L and
+//        E ~ pi (1 / N) sum L(l_i)       (exact for a constant environment).
+//    Default 1024 samples, filtered (see below).
+//
+// Filtering (filtered = true): each node / sample reads the source lod whose texel solid angle
+// matches its share of the sphere times 4^lod_bias (Krivanek & Colbert 2008, as in
+// integrate/prefilter.hpp): the Riemann node's own solid angle sin(theta) dtheta dphi, or
+// 1 / (N pdf) = pi / (N cos theta) for cosine sampling. Without filtering every sample reads
+// level 0 (the literature). Output: irradiance_cubemap gives a one-level cubemap<float> of face
+// size `size` (32 by default: irradiance is smooth, its spectrum ends at SH band 2 to within 1%).
+// Non-finite radiance reads as 0; samples = 0 (or n_theta, n_phi = 0) are clamped to 1.
+
+#include <cmath>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+#include <vector>
+
+#include "../core/constants.hpp"
+#include "../core/executor.hpp"
+#include "../core/vec.hpp"
+#include "../env/cubemap.hpp"
+#include "../env/environment.hpp"
+#include "../sampling/hemisphere.hpp"
+#include "../sampling/sequence.hpp"
+#include "sphere_convolve.hpp"
+
+namespace ibl {
+
+enum class irradiance_method : int {
+    riemann = 0,           ///< midpoint rule in (theta, phi), the literature's
+    cosine_importance = 1, ///< cosine-distributed Hammersley directions
+};
+
+struct irradiance_options {
+    int size = 32; ///< output face size
+    irradiance_method method = irradiance_method::cosine_importance;
+    std::uint32_t samples = 1024; ///< cosine_importance: directions per texel
+    int n_theta = 64;            ///< riemann: polar nodes
+    int n_phi = 256;             ///< riemann: azimuthal nodes
+    bool filtered = true;        ///< read prefiltered source mips (see the header)
+    double lod_bias = 0.5;
+};
+
+/// Riemann (midpoint) table: n_theta x n_phi nodes, weights cos sin, scale pi^2 / N, not
+/// normalised. lod_of_solid_angle(node solid angle) gives each node's lod.
+template <class S, class LodFn>
+sphere_sample_table<S> make_irradiance_riemann_table(int n_theta, int n_phi, LodFn&& lod_of_solid_angle) {
+    const int nt = n_theta > 0 ? n_theta : 1, np = n_phi > 0 ? n_phi : 1;
+    const double dt = half_pi_v<double> / double(nt), dp = two_pi_v<double> / double(np);
+    sphere_sample_table<S> t;
+    t.drawn = std::uint32_t(nt) * std::uint32_t(np);
+    t.normalised = false;
+    t.scale = S(sqr(pi_v<double>) / (double(nt) * double(np)));
+    for (int i = 0; i < nt; ++i) {
+        const double theta = (double(i) + 0.5) * dt;
+        const double st = std::sin(theta), ct = std::cos(theta);
+        const S lod = S(lod_of_solid_angle(st * dt * dp));
+        for (int j = 0; j < np; ++j) {
+            const double phi = (double(j) + 0.5) * dp;
+            t.push(vec3<S>(vec3<double>(st * std::cos(phi), st * std::sin(phi), ct)), S(ct * st), lod);
+        }
+    }
+    return t;
+}
+
+/// Cosine-importance table: N Hammersley directions (0 -> 1) of density cos / pi, weight 1 each
+/// (L cos / pdf = pi L), scale pi, normalised by the weight sum. Point 0 of the Hammersley set
+/// lies exactly on the horizon (cos = 0, density 0) and is dropped, so the estimate is pi times
+/// the mean over the N - 1 others (an exactly hemispherical set: a ground below a normal pointing
+/// down is not mixed with the horizon's sky). Lods use cos clamped to 1 / N (footprint <= pi sr).
+template <class S, class LodFn>
+sphere_sample_table<S> make_irradiance_cosine_table(std::uint32_t samples, LodFn&& lod_of_solid_angle) {
+    const std::uint32_t n = samples > 0 ? samples : 1;
+    sphere_sample_table<S> t;
+    t.drawn = n;
+    t.normalised = true;
+    t.scale = S(pi_v<double>);
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const vec3<double> l = sample_cosine_hemisphere(hammersley<double>(i, n));
+        if (!(l.z > 0.0) && n > 1) continue;
+        const double c = l.z > 1.0 / double(n) ? l.z : 1.0 / double(n);
+        t.push(vec3<S>(l), S(1), S(lod_of_solid_angle(pi_v<double> / (double(n) * c))));
+    }
+    return t;
+}
+
+/// The irradiance table for a source and options.
+template <class S, class Env> sphere_sample_table<S> make_irradiance_table_for(const Env& env, const irradiance_options& opt) {
+    using Te = std::conditional_t<environment<Env, float>, float, double>;
+    auto lod = [&](double omega) -> double {
+        if (!opt.filtered) return 0.0;
+        return double(env_lod_for_solid_angle<Te>(env, Te(omega * std::exp2(2.0 * opt.lod_bias))));
+    };
+    if (opt.method == irradiance_method::riemann) return make_irradiance_riemann_table<S>(opt.n_theta, opt.n_phi, lod);
+    return make_irradiance_cosine_table<S>(opt.samples, lod);
+}
+
+/// Irradiance E at one unit normal of any environment (double accumulation).
+template <class T, class Env>
+    requires environment<Env, T>
+[[nodiscard]] vec3<T> irradiance(const Env& env, const vec3<T>& normal, const irradiance_options& opt = {}) {
+    return convolve_direction<T>(env, make_irradiance_table_for<double>(env, opt), normal);
+}
+
+/// Irradiance cubemap (one level, face size opt.size) of an environment: E at every texel centre.
+template <class Env, class Executor = serial_executor>
+cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt = {}, Executor&& ex = Executor{}) {
+    if (opt.size < 1) throw std::invalid_argument("ibl::irradiance_cubemap: size must be >= 1, got " + std::to_string(opt.size));
+    const int n = opt.size;
+    cubemap<float> out(n, 1);
+    const std::vector<vec3<float>> texels = convolve_faces(env, make_irradiance_table_for<float>(env, opt), n, ex);
+    out.fill(0, [&](int f, int x, int y) {
+        return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
+    });
+    out.update_borders();
+    return out;
+}
+
+} // namespace ibl
