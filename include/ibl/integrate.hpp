@@ -5,4 +5,6 @@
 #include "integrate/dfg_fit.hpp"
 #include "integrate/dfg_lut.hpp"
 #include "integrate/dfg_multiscatter.hpp"
+#include "integrate/env_importance.hpp"
 #include "integrate/gauss_legendre.hpp"
+#include "integrate/radiance_reference.hpp"
