@@ -5,6 +5,7 @@
 //                __host__ __device__ when the translation unit is compiled by nvcc, so the same
 //                headers serve CPU code and CUDA device code.
 // IBL_FUNC_VOID  the same without [[nodiscard]], for functions returning void.
+// IBL_RESTRICT   the compilers' restrict qualifier, for the pointer arguments of batch kernels.
 // IBL_ASSERT(c)  precondition checks on the host (default: assert from <cassert>). Define it before
 //                including any ibl header to route checks into an engine's own assert. Device code
 //                never asserts: under nvcc device compilation it expands to nothing.
@@ -19,6 +20,14 @@
 
 #define IBL_FUNC [[nodiscard]] IBL_HOST_DEVICE inline
 #define IBL_FUNC_VOID IBL_HOST_DEVICE inline
+
+#ifndef IBL_RESTRICT
+#if defined(_MSC_VER)
+#define IBL_RESTRICT __restrict
+#else
+#define IBL_RESTRICT __restrict__
+#endif
+#endif
 
 #ifndef IBL_ASSERT
 #if defined(__CUDA_ARCH__)

@@ -55,14 +55,6 @@
 #include "../core/config.hpp"
 #include "../core/vec.hpp"
 
-#if !defined(IBL_RESTRICT)
-#if defined(_MSC_VER)
-#define IBL_RESTRICT __restrict
-#else
-#define IBL_RESTRICT __restrict__
-#endif
-#endif
-
 namespace ibl {
 
 /// Number of coefficients of a B-band expansion.
