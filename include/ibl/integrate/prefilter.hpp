@@ -23,9 +23,13 @@
 // have no texels and always read lod 0). Krivanek-Colbert and Filament's libibl add a bias of
 // +1 (a footprint of 4 Omega_s). Here the default is +0.5: the bilinear reconstruction of the
 // mips already spreads a texel over about 2 x 2 texels, and on a sky with a sun (bench_prefilter,
-// 256^2 source, 128 samples) +1 over-blurs the rough levels (the sun leaks into texels facing
-// away from it: largest overshoot 9-13 times the reference at r = 1) while +0 keeps much of plain
-// importance sampling's noise near the sun (normalised RMSE 0.3-0.35 at r >= 0.5 against 0.15-0.25).
+// 256^2 source, 128-256 samples) +1 over-blurs the rough levels (the sun leaks into texels facing
+// away from it: largest overshoot 6-11 times the reference at r = 1) while +0 keeps much of plain
+// importance sampling's noise near the sun (normalised RMSE 0.3 at r >= 0.5 against 0.15-0.25).
+// Fetch: by default each sample reads only the nearest level round(lod) (one bilinear tap);
+// trilinear = true blends two levels at twice the cost. At equal cost, 256 nearest-level samples
+// beat 128 trilinear ones on the sky + sun (relative RMSE per level 0.15/0.15/0.23/0.34 against
+// 0.22/0.25/0.31/0.75).
 // prefilter tests and bench_prefilter measure it. With bias = -inf (or method = importance) every
 // sample reads level 0: plain importance sampling.
 //
@@ -33,7 +37,8 @@
 // shared by every texel: tangent-space l, weight n.l, lod; samples with n.l <= 0 are dropped.
 // Per texel the table is rotated into the frame make_frame(R) of the texel centre R. The hot loop
 // is the cubemap fast path of integrate/sphere_convolve.hpp (structure of arrays over a face row,
-// trilinear lookups split into per-level bilinear taps, blocked float accumulation).
+// one bilinear tap per sample on a level that is the same for every texel, or two for trilinear
+// reads; blocked float accumulation).
 //
 // Levels (roughness_mip.hpp): level l of the output holds roughness policy.roughness(l, levels)
 // at face size max(1, base_size >> l). Level 0 is r = 0, not an integral: a copy of the source
@@ -92,14 +97,18 @@ struct prefilter_options {
     std::vector<std::uint32_t> samples_per_level{};
     /// Filtered importance sampling: lod bias added to 0.5 log2(Omega_s / Omega_0).
     double lod_bias = 0.5;
+    /// Cubemap fast path: trilinear reads (two bilinear taps per sample); false reads only the
+    /// nearest level round(lod) (one tap: half the cost, the lod quantised to whole levels).
+    bool trilinear = false;
 };
 
 /// Default samples per texel of a level of roughness r: 1024 for plain importance sampling (the
-/// literature's count); 128 for filtered importance sampling, the smallest power of two whose
-/// relative and normalised RMSE on the default sky + sun (bench_prefilter: 256^2 source, linear
-/// policy, 5 levels) are below those of 1024-sample importance sampling at every level.
+/// literature's count); 256 for filtered importance sampling (nearest-level reads), the smallest
+/// power of two whose relative and normalised RMSE on the default sky + sun (bench_prefilter:
+/// 256^2 source, linear policy, 5 levels) are below those of 1024-sample importance sampling at
+/// every level.
 inline std::uint32_t default_prefilter_samples(prefilter_method method, double /*roughness*/) {
-    return method == prefilter_method::importance ? 1024u : 128u;
+    return method == prefilter_method::importance ? 1024u : 256u;
 }
 
 /// The GGX LD sample table for one roughness (N = V = R): N Hammersley samples, n.l weights,
@@ -210,8 +219,9 @@ cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     store(0, detail::prefilter_base(env, base, ex));
     for (int l = 1; l < levels; ++l) {
         const double r = opt.policy.roughness(double(l), levels);
-        const sphere_sample_table<float> table =
+        sphere_sample_table<float> table =
             make_ld_table_for<float>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias);
+        table.trilinear = opt.trilinear;
         store(l, convolve_faces(env, table, out.size(l), ex));
     }
     out.update_borders();

@@ -57,6 +57,7 @@ template <class T> struct sphere_sample_table {
     std::vector<T> lod;       ///< source lod to read
     T scale = T(1);           ///< the estimate's constant factor
     bool normalised = true;   ///< divide by sum of weights (else by 1)
+    bool trilinear = true;    ///< fast path: blend floor(lod) and floor(lod) + 1 (else round(lod) only)
     std::uint32_t drawn = 0;  ///< samples drawn, including those dropped (weight 0)
 
     [[nodiscard]] std::size_t size() const noexcept { return weight.size(); }
@@ -160,6 +161,10 @@ template <class S> tap_table make_taps(const sphere_sample_table<S>& table, int 
         const int l0 = int(lod);
         const double f = lod - double(l0);
         const double w = double(table.weight[i]);
+        if (!table.trilinear) {
+            push(i, f < 0.5 ? l0 : l0 + 1, w);
+            continue;
+        }
         push(i, l0, w * (1.0 - f));
         if (f > 0.0) push(i, l0 + 1, w * f);
     }
