@@ -69,6 +69,15 @@
 //   executor and folded in batch order: the result depends only on the inputs and options.
 //   samples = total radiance evaluations (draws) over all batches; per batch samples / batches
 //   (at least 1), batches >= 2. The mirror term costs one more evaluation and has zero error.
+//   Caveat (every sample-based error bar has it): a bright feature that no batch hits is
+//   invisible to the standard error. BRDF sampling alone under the default sky's sun at 1024
+//   samples returns a value 99% low with a 0.4% standard error (bench_radiance_reference); with
+//   environment sampling in the mix every batch hits the sun. Use mis for peaked environments.
+//   Figures (default sky, sun reflected by a dielectric at r = 0.3, proposal baked at 128^2):
+//   relative se 4% at 2^10 samples, 1% at 2^12, 0.16% at 2^16, 0.055% at 2^18 (BRDF only: 16%,
+//   5%, 3%, 0.8% at 2^12..2^18). The residual MIS error is the sun's edge: a texel the cap covers
+//   partly is drawn by its mean luminance and its draws hit or miss the sun (relative variance
+//   (1 - c) / c at coverage c); a finer proposal cube shrinks the partly covered share.
 //
 // ---- Domains ------------------------------------------------------------------------------------
 //   n, v unit (world space); n.v is clamped to [0, 1] by projecting v onto n's upper hemisphere
@@ -240,7 +249,7 @@ template <class Env> vec3<double> rr_radiance(const Env& env, const vec3<double>
 }
 
 /// MIS weight of the technique with q_self = n_self pdf_self against q_other.
-inline double mis_weight(double q_self, double q_other, mis_heuristic h) noexcept {
+inline double rr_mis_weight(double q_self, double q_other, mis_heuristic h) noexcept {
     if (!(q_self > 0.0)) return 0.0;
     const double ratio = q_other / q_self;
     return h == mis_heuristic::power ? 1.0 / (1.0 + ratio * ratio) : 1.0 / (1.0 + ratio);
@@ -289,7 +298,7 @@ product_estimate integrate_product_mis(const Env& env, const cube_env_distributi
                 const lobe_value g = lobe.eval(s.dir);
                 if (g.parts[0] == vec3<double>(0.0) && g.parts[1] == vec3<double>(0.0)) continue;
                 const double pe = n_e > 0 ? dist->pdf(s.dir) : 0.0;
-                const double w = detail::mis_weight(nb * s.pdf, ne * pe, opt.heuristic) / s.pdf;
+                const double w = detail::rr_mis_weight(nb * s.pdf, ne * pe, opt.heuristic) / s.pdf;
                 const vec3<double> l = detail::rr_radiance(env, s.dir);
                 sum_b[0] += (w * l) * g.parts[0];
                 sum_b[1] += (w * l) * g.parts[1];
@@ -301,7 +310,7 @@ product_estimate integrate_product_mis(const Env& env, const cube_env_distributi
                 const lobe_value g = lobe.eval(s.dir);
                 if (g.parts[0] == vec3<double>(0.0) && g.parts[1] == vec3<double>(0.0)) continue;
                 const double pb = n_b > 0 ? double(lobe.pdf(s.dir)) : 0.0;
-                const double w = detail::mis_weight(ne * s.pdf, nb * pb, opt.heuristic) / s.pdf;
+                const double w = detail::rr_mis_weight(ne * s.pdf, nb * pb, opt.heuristic) / s.pdf;
                 const vec3<double> l = detail::rr_radiance(env, s.dir);
                 sum_e[0] += (w * l) * g.parts[0];
                 sum_e[1] += (w * l) * g.parts[1];
