@@ -43,6 +43,7 @@
 #include <utility>
 #include <vector>
 
+#include "detail/level_solid_angle.hpp"
 #include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
@@ -132,22 +133,12 @@ public:
     // ---- environment concept ----------------------------------------------------------------
 
     [[nodiscard]] T texel_solid_angle(T lod) const noexcept {
-        const T l = clamp(lod, T(0), max_lod());
-        const int l0 = int(l);
-        const T f = l - T(l0);
-        if (!(f > T(0))) return levels_[std::size_t(l0)].omega;
-        const T a = levels_[std::size_t(l0)].log2_omega, b = levels_[std::size_t(l0) + 1].log2_omega;
-        return std::exp2(a + f * (b - a));
+        return detail::level_texel_solid_angle(levels_, lod, max_lod());
     }
 
+    /// The lod whose average texel solid angle is omega, clamped to [0, max_lod()]; 0 for NaN.
     [[nodiscard]] T lod_for_solid_angle(T omega) const noexcept {
-        if (!(omega > levels_[0].omega)) return T(0);
-        const T x = std::log2(omega);
-        for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
-            const T a = levels_[l].log2_omega, b = levels_[l + 1].log2_omega;
-            if (x <= b) return T(l) + (x - a) / (b - a);
-        }
-        return max_lod();
+        return detail::level_lod_for_solid_angle(levels_, omega, max_lod());
     }
 
     /// Trilinear radiance: bilinear on floor(lod) and floor(lod) + 1 (lod clamped, NaN -> 0).
