@@ -1,0 +1,74 @@
+#pragma once
+// examples/ibl_bake/bake_options.hpp — the command line of ibl-bake and the quality presets.
+//
+// Every option is checked before anything is computed or written: a bad option throws
+// usage_error (main prints "ibl-bake: <message>" and the hint to --help, exit status 2).
+//
+//   --input PATH        lat-long (2:1) Radiance .hdr or OpenEXR; omitted: the built-in sky + sun
+//   --out DIR           output directory (required)
+//   --size N            face size of the prefiltered base level, 1..4096 (default 256)
+//   --lut-size N        DFG LUT texels per side, 1..1024 (default 128)
+//   --levels N          prefiltered levels, 0 = automatic (default): floor(log2 N) - 1 clamped
+//                       to [1, 6] (smallest face >= 4 for N >= 16), at most the full chain
+//   --threads N         worker threads, 0 = all cores (default 0), at most 256
+//   --quality Q         low | default | high (the mapping is quality_settings below)
+//   --ktx2-format F     f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | f32
+//   --quiet             no progress output on stderr
+//   --help, --version
+// Values may be given as "--size 32" or "--size=32". Numbers must be plain decimal integers.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <ibl/integrate/dfg.hpp>
+
+namespace ibl_bake {
+
+class usage_error : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+enum class quality { low, standard, high };
+
+struct bake_options {
+    std::string input;   ///< empty: the built-in sky
+    std::string out;
+    int size = 256;
+    int lut_size = 128;
+    int levels = 0;      ///< 0: automatic
+    unsigned threads = 0;
+    quality q = quality::standard;
+    bool ktx2_f32 = false;
+    bool quiet = false;
+    bool help = false;
+    bool version = false;
+};
+
+/// Cost knobs of one quality preset (docs/ibl-bake.md has the table).
+struct quality_settings {
+    const char* name;
+    int bake_k;                      ///< k x k sub-samples per source texel (lat-long / sky -> cube)
+    std::uint32_t prefilter_samples; ///< GGX samples per texel and level (filtered IS)
+    bool trilinear;                  ///< prefilter reads two source levels per sample
+    ibl::dfg_quadrature_nodes dfg_nodes;
+    std::uint32_t ld_ref_samples;    ///< reference LD (lat-long sources) per texel
+    std::uint32_t sky_ref_samples;   ///< reference LD of the sky without its sun per texel
+    int sun_cap_nodes;               ///< reference: radial nodes over the sun cap
+    int ref_grid;                    ///< specular check: ref_grid^2 texels per face and level
+    std::uint32_t split_sum_samples; ///< MIS reference of outgoing radiance per view
+};
+
+quality_settings settings_for(quality q);
+
+/// Parses argv[1..argc). Throws usage_error.
+bake_options parse_options(const std::vector<std::string>& args);
+
+/// Automatic level count for a base face size (see --levels).
+int auto_levels(int size);
+
+std::string usage_text();
+
+} // namespace ibl_bake
