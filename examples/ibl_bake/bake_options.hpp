@@ -59,6 +59,7 @@ struct quality_settings {
     int sun_cap_nodes;               ///< reference: radial nodes over the sun cap
     int ref_grid;                    ///< specular check: ref_grid^2 texels per face and level
     std::uint32_t split_sum_samples; ///< MIS reference of outgoing radiance per view
+    int preview_ss;                  ///< preview: preview_ss^2 sub-pixel samples
 };
 
 quality_settings settings_for(quality q);

@@ -69,7 +69,6 @@ constexpr int sh_brute_max_face = 128; ///< brute-force irradiance over a source
 constexpr int dfg_check_grid = 16;    ///< DFG check: 16 x 16 texels (fewer if the LUT is smaller)
 constexpr int dist_max_face = 128;    ///< env distribution of the split-sum reference: face <= this
 constexpr int preview_cell = 128;     ///< preview: pixels per sphere cell
-constexpr int preview_ss = 4;         ///< preview: 4 x 4 sub-pixel samples
 constexpr double preview_key = 0.6;   ///< preview exposure: key / mean luminance of the environment
 constexpr double preview_hfov_deg = 90.0;
 
@@ -293,7 +292,7 @@ camera make_camera(const dvec3& light) {
 }
 
 image_rgb32f render_preview(const baked_products& bp, const ibl::cubemap<float>& source, const camera& cam,
-                            pool_executor& ex) {
+                            int preview_ss, pool_executor& ex) {
     constexpr int cols = 5, rows = 2;
     const int w = cols * preview_cell, h = rows * preview_cell;
     image_rgb32f img(w, h);
@@ -628,12 +627,12 @@ void run_bake(const bake_options& opt, std::FILE* out) {
     // ---- preview ---------------------------------------------------------------------------
     prog.begin("preview");
     const camera cam = make_camera(light);
-    const image_rgb32f preview = render_preview(bp, source, cam, ex);
+    const image_rgb32f preview = render_preview(bp, source, cam, qs.preview_ss, ex);
     png_options png;
     png.op = tonemap::reinhard;
     png.exposure = float(preview_key / std::max(lstats.mean, 1e-6));
     const double preview_ms = prog.end();
-    rows.push_back({"preview", "baked products, orthographic spheres", "640x256, 4x4 ss", preview_ms,
+    rows.push_back({"preview", "baked products, orthographic spheres", "640x256, " + std::to_string(qs.preview_ss) + "x" + std::to_string(qs.preview_ss) + " ss", preview_ms,
                     fmt("exposure %.3g", png.exposure)});
 
     // ---- files -----------------------------------------------------------------------------

@@ -1,0 +1,352 @@
+// examples/ibl_bake/tests/test_tool.cpp — end-to-end tests of the ibl-bake executable: a full run
+// produces every file with the right sizes and parseable JSON; output is bit-identical across
+// thread counts; bad options and bad inputs exit non-zero with a message and leave DIR untouched.
+// The executable's path comes from the IBL_BAKE_TOOL definition (CMake: $<TARGET_FILE:ibl_bake>).
+
+#include <doctest/doctest.h>
+
+#include "image_io.hpp"
+#include "ktx2.hpp"
+
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace ibl_bake;
+
+namespace {
+
+const std::string tool = IBL_BAKE_TOOL;
+const std::string data_dir = IBL_BAKE_TEST_DATA_DIR;
+const std::vector<std::string> faces = {"px", "nx", "py", "ny", "pz", "nz"};
+
+struct scratch_dir {
+    fs::path path;
+    explicit scratch_dir(const std::string& tag) {
+        path = fs::temp_directory_path() / ("ibl_bake_tool_tests_" + tag + "_" + std::to_string(::getpid()));
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~scratch_dir() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+std::string slurp(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+struct run_result {
+    int status;
+    std::string out, err;
+};
+
+std::string quote(const std::string& s) {
+    std::string q = "'";
+    for (char c : s) q += c == '\'' ? std::string("'\\''") : std::string(1, c);
+    return q + "'";
+}
+
+/// Runs the tool with args (stdout, stderr captured into files of `scratch`).
+run_result run(const scratch_dir& scratch, const std::vector<std::string>& args) {
+    std::string cmd = quote(tool);
+    for (const auto& a : args) cmd += " " + quote(a);
+    const std::string o = scratch / "stdout.txt", e = scratch / "stderr.txt";
+    cmd += " >" + quote(o) + " 2>" + quote(e);
+    const int st = std::system(cmd.c_str());
+    run_result r;
+    r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    r.out = slurp(o);
+    r.err = slurp(e);
+    return r;
+}
+
+// ---- a minimal JSON parser (RFC 8259 subset: no \u escapes beyond pass-through) ------------------
+
+struct json {
+    enum kind_t { null_v, bool_v, number_v, string_v, array_v, object_v } kind = null_v;
+    double number = 0;
+    bool boolean = false;
+    std::string str;
+    std::vector<json> items;
+    std::map<std::string, json> fields;
+    const json& operator[](const std::string& k) const {
+        static const json none;
+        auto it = fields.find(k);
+        return it == fields.end() ? none : it->second;
+    }
+    bool has(const std::string& k) const { return fields.count(k) != 0; }
+};
+
+struct json_parser {
+    const std::string& s;
+    std::size_t i = 0;
+    void ws() {
+        while (i < s.size() && std::isspace(static_cast<unsigned char>(s[i]))) ++i;
+    }
+    void expect(char c) {
+        ws();
+        if (i >= s.size() || s[i] != c) throw std::runtime_error(std::string("json: expected ") + c + " at " + std::to_string(i));
+        ++i;
+    }
+    std::string string_lit() {
+        expect('"');
+        std::string out;
+        while (i < s.size() && s[i] != '"') {
+            if (s[i] == '\\') ++i;
+            out += s[i++];
+        }
+        expect('"');
+        return out;
+    }
+    json value() {
+        ws();
+        if (i >= s.size()) throw std::runtime_error("json: unexpected end");
+        json v;
+        const char c = s[i];
+        if (c == '{') {
+            v.kind = json::object_v;
+            ++i;
+            ws();
+            if (s[i] == '}') return ++i, v;
+            for (;;) {
+                const std::string k = string_lit();
+                expect(':');
+                v.fields[k] = value();
+                ws();
+                if (s[i] == ',') { ++i; continue; }
+                expect('}');
+                return v;
+            }
+        }
+        if (c == '[') {
+            v.kind = json::array_v;
+            ++i;
+            ws();
+            if (s[i] == ']') return ++i, v;
+            for (;;) {
+                v.items.push_back(value());
+                ws();
+                if (s[i] == ',') { ++i; continue; }
+                expect(']');
+                return v;
+            }
+        }
+        if (c == '"') {
+            v.kind = json::string_v;
+            v.str = string_lit();
+            return v;
+        }
+        if (s.compare(i, 4, "true") == 0) return i += 4, v.kind = json::bool_v, v.boolean = true, v;
+        if (s.compare(i, 5, "false") == 0) return i += 5, v.kind = json::bool_v, v;
+        if (s.compare(i, 4, "null") == 0) return i += 4, v;
+        char* end = nullptr;
+        v.number = std::strtod(s.c_str() + i, &end);
+        if (end == s.c_str() + i) throw std::runtime_error("json: bad value at " + std::to_string(i));
+        i = std::size_t(end - s.c_str());
+        v.kind = json::number_v;
+        return v;
+    }
+};
+
+json parse_json(const std::string& text) {
+    json_parser p{text};
+    json v = p.value();
+    p.ws();
+    if (p.i != text.size()) throw std::runtime_error("json: trailing characters");
+    return v;
+}
+
+bool is_triples(const json& a, std::size_t count) {
+    if (a.kind != json::array_v || a.items.size() != count) return false;
+    for (const auto& t : a.items) {
+        if (t.kind != json::array_v || t.items.size() != 3) return false;
+        for (const auto& x : t.items)
+            if (x.kind != json::number_v) return false;
+    }
+    return true;
+}
+
+std::set<std::string> entries(const fs::path& dir) {
+    std::set<std::string> s;
+    if (!fs::exists(dir)) return s;
+    for (const auto& e : fs::directory_iterator(dir)) s.insert(e.path().filename().string());
+    return s;
+}
+
+const std::vector<std::string> tiny = {"--size", "16", "--lut-size", "16", "--quality", "low", "--quiet"};
+
+std::vector<std::string> with(std::vector<std::string> a, const std::vector<std::string>& more) {
+    a.insert(a.end(), more.begin(), more.end());
+    return a;
+}
+
+} // namespace
+
+TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
+    scratch_dir s("full");
+    const std::string out = s / "bake";
+    const run_result r = run(s, with(tiny, {"--threads", "2", "--out", out}));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.out.find("specular chain") != std::string::npos);
+    CHECK(r.out.find("split sum metal r=0.9") != std::string::npos);
+    constexpr int levels = 3; // auto_levels(16): 16, 8, 4
+    for (int l = 0; l < levels; ++l)
+        for (const auto& f : faces) {
+            const image_rgb32f img = read_image(out + "/specular_l" + std::to_string(l) + "_" + f + ".exr");
+            CHECK(img.width == (16 >> l));
+            CHECK(img.height == (16 >> l));
+        }
+    CHECK_FALSE(fs::exists(out + "/specular_l3_px.exr"));
+    const std::string ktx = slurp(out + "/specular.ktx2");
+    const ktx2_info info = parse_ktx2(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(ktx.data()), ktx.size()));
+    CHECK(info.face_count == 6);
+    CHECK(info.level_count == levels);
+    CHECK(info.pixel_width == 16);
+    CHECK(info.vk_format == 97); // rgba16f default
+    const image_rgb32f dfg = read_image(out + "/dfg.exr");
+    CHECK(dfg.width == 16);
+    CHECK(dfg.height == 16);
+    CHECK(slurp(out + "/dfg.hpp").find("dfg_lut_size = 16;") != std::string::npos);
+    CHECK(slurp(out + "/preview.png").substr(1, 3) == "PNG");
+
+    const json sh = parse_json(slurp(out + "/sh.json"));
+    CHECK(sh["bands"].number == 3);
+    CHECK(is_triples(sh["radiance"], 9));
+    CHECK(is_triples(sh["irradiance"], 9));
+    CHECK(sh["convention"].str.find("+Y up") != std::string::npos);
+    CHECK(sh["window"]["applied"].kind == json::bool_v);
+    CHECK(sh["window"]["applied"].boolean); // the default sky's sun rings
+    CHECK(sh["window"]["min_irradiance_before"].items.size() == 3);
+
+    const json rep = parse_json(slurp(out + "/report.json"));
+    for (const char* k : {"source", "specular", "sh", "dfg", "split_sum", "preview", "files", "total_time_ms"})
+        CHECK_MESSAGE(rep.has(k), k);
+    const json& lv = rep["specular"]["levels"];
+    REQUIRE(lv.items.size() == std::size_t(levels));
+    for (int l = 0; l < levels; ++l) {
+        CHECK(lv.items[std::size_t(l)]["level"].number == l);
+        CHECK(lv.items[std::size_t(l)]["size"].number == (16 >> l));
+        CHECK(lv.items[std::size_t(l)]["roughness"].number == doctest::Approx(l / double(levels - 1)));
+        CHECK(lv.items[std::size_t(l)]["rel_rmse"].kind == json::number_v);
+        CHECK(lv.items[std::size_t(l)]["max_overshoot"].kind == json::number_v);
+    }
+    CHECK(rep["specular"]["time_ms"].kind == json::number_v);
+    CHECK(rep["sh"]["check"]["max_rel"].kind == json::number_v);
+    CHECK(rep["dfg"]["check"]["max_abs"].number < 1e-2);
+    CHECK(rep["split_sum"]["materials"].items.size() == 6);
+    // nothing else in the parent: the staging directory is gone
+    CHECK(entries(s.path) == std::set<std::string>{"bake", "stderr.txt", "stdout.txt"});
+}
+
+TEST_CASE("deterministic: bit-identical outputs with 1 and 2 threads") {
+    scratch_dir s("det");
+    const std::string a = s / "a", b = s / "b";
+    REQUIRE(run(s, with(tiny, {"--threads", "1", "--out", a})).status == 0);
+    REQUIRE(run(s, with(tiny, {"--threads", "2", "--out", b})).status == 0);
+    const std::set<std::string> fa = entries(a);
+    REQUIRE(fa == entries(b));
+    int compared = 0;
+    for (const auto& f : fa) {
+        if (f == "report.json") continue; // holds times and the thread count
+        INFO(f);
+        CHECK(slurp(a + "/" + f) == slurp(b + "/" + f));
+        ++compared;
+    }
+    CHECK(compared == 18 + 5);
+}
+
+TEST_CASE("bad options: exit 2 with a message, nothing created") {
+    scratch_dir s("opts");
+    const std::string out = s / "bake";
+    const std::vector<std::vector<std::string>> cases = {
+        {"--out", out, "--frobnicate"},
+        {"--out", out, "--size", "abc"},
+        {"--out", out, "--size", "0"},
+        {"--out", out, "--size", "5000"},
+        {"--out", out, "--size", "16x"},
+        {"--out", out, "--size"},
+        {"--out", out, "--lut-size", "0"},
+        {"--out", out, "--threads", "-1"},
+        {"--out", out, "--quality", "ultra"},
+        {"--out", out, "--levels", "9", "--size", "16"},
+        {"--size", "16"},
+        {"stray", "--out", out},
+    };
+    for (const auto& c : cases) {
+        const run_result r = run(s, c);
+        INFO(c.back());
+        CHECK(r.status == 2);
+        CHECK(r.err.find("ibl-bake: ") == 0);
+        CHECK_FALSE(fs::exists(out));
+    }
+    CHECK(run(s, {"--help"}).status == 0);
+}
+
+TEST_CASE("bad inputs: exit 1 with a message naming the file, DIR untouched, no partial files") {
+    scratch_dir s("inputs");
+    // truncated EXR: the first 4 KiB of courtyard.exr
+    const std::string full = slurp(data_dir + "/courtyard.exr");
+    REQUIRE(full.size() > 4096);
+    std::ofstream(s / "truncated.exr", std::ios::binary) << full.substr(0, 4096);
+    // LDR input: an 8-bit PNG
+    {
+        image_rgb32f img(8, 4);
+        const auto png = encode_png(img);
+        std::ofstream(s / "ldr.png", std::ios::binary).write(reinterpret_cast<const char*>(png.data()), std::streamsize(png.size()));
+    }
+    // not 2:1
+    {
+        image_rgb32f img(8, 8);
+        const auto exr = encode_exr(img);
+        std::ofstream(s / "square.exr", std::ios::binary).write(reinterpret_cast<const char*>(exr.data()), std::streamsize(exr.size()));
+    }
+    std::ofstream(s / "empty.hdr", std::ios::binary).flush();
+    // an existing output directory with a user's file must stay exactly as it is
+    const std::string out = s / "bake";
+    fs::create_directories(out);
+    std::ofstream(out + "/keep.txt") << "mine";
+    for (const char* in : {"missing.exr", "truncated.exr", "ldr.png", "square.exr", "empty.hdr"}) {
+        const run_result r = run(s, with(tiny, {"--input", s / in, "--out", out}));
+        INFO(in, r.err);
+        CHECK(r.status == 1);
+        CHECK(r.err.find(in) != std::string::npos);
+        CHECK(entries(out) == std::set<std::string>{"keep.txt"});
+    }
+    // an output path that is a file
+    const run_result r = run(s, with(tiny, {"--out", s / "ldr.png"}));
+    CHECK(r.status == 1);
+    // no staging directories left behind
+    for (const auto& e : entries(s.path)) CHECK(e.find(".ibl-bake-") == std::string::npos);
+}
+
+TEST_CASE("existing DIR: files replaced, other files kept, stale levels removed") {
+    scratch_dir s("rebake");
+    const std::string out = s / "bake";
+    fs::create_directories(out);
+    std::ofstream(out + "/keep.txt") << "mine";
+    std::ofstream(out + "/specular_l7_px.exr") << "stale";
+    std::ofstream(out + "/dfg.exr") << "old";
+    const run_result r = run(s, with(tiny, {"--out", out}));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(slurp(out + "/keep.txt") == "mine");
+    CHECK_FALSE(fs::exists(out + "/specular_l7_px.exr"));
+    CHECK(read_image(out + "/dfg.exr").width == 16);
+    for (const auto& e : entries(s.path)) CHECK(e.find(".ibl-bake-") == std::string::npos);
+}
