@@ -38,6 +38,7 @@
 namespace ibl {
 
 template <class T> struct constant_environment {
+    using scalar_type = T;
     vec3<T> value{T(1)};
 
     IBL_FUNC vec3<T> radiance(const vec3<T>& /*dir*/, T /*lod*/ = T(0)) const noexcept { return value; }
@@ -50,6 +51,7 @@ template <class T> struct constant_environment {
 };
 
 template <class T> struct sky_environment {
+    using scalar_type = T;
     vec3<T> zenith{T(0.15), T(0.3), T(0.75)};  ///< sky radiance straight up
     vec3<T> horizon{T(0.7), T(0.8), T(0.95)};  ///< sky radiance at the horizon (dir.y = 0+)
     vec3<T> ground{T(0.2), T(0.18), T(0.15)};  ///< radiance of every direction below the horizon
@@ -130,6 +132,7 @@ template <class T> sky_environment<T> make_default_sky() noexcept {
 
 /// Adapter: an environment from a callable f(vec3<T> unit dir) -> vec3<T> (lod ignored).
 template <class T, class F> struct lambda_environment {
+    using scalar_type = T;
     F fn;
 
     [[nodiscard]] vec3<T> radiance(const vec3<T>& dir, T /*lod*/ = T(0)) const { return vec3<T>(fn(dir)); }

@@ -22,6 +22,7 @@
 
 #include <cmath>
 #include <concepts>
+#include <type_traits>
 
 #include "../core/config.hpp"
 #include "../core/vec.hpp"
@@ -58,5 +59,24 @@ template <class T, class E> [[nodiscard]] inline T env_lod_for_solid_angle(const
         return lod < hi ? lod : hi;
     }
 }
+
+namespace detail {
+template <class E> struct environment_scalar {
+    // GLM vectors convert implicitly, so environment<E, float> also holds for a double
+    // environment: prefer double, and let an explicit scalar_type member decide first.
+    using type = std::conditional_t<environment<E, double>, double, float>;
+};
+template <class E>
+    requires requires { typename E::scalar_type; }
+struct environment_scalar<E> {
+    using type = typename E::scalar_type;
+};
+} // namespace detail
+
+/// The scalar type an environment computes in: its `scalar_type` member when it has one (every
+/// library environment does), else double when it models environment<E, double>, else float.
+/// Reference integrators evaluate radiance in this type so that a double environment is never
+/// silently evaluated in float.
+template <class E> using environment_scalar_t = typename detail::environment_scalar<E>::type;
 
 } // namespace ibl

@@ -233,18 +233,9 @@ IBL_FUNC vec2<double> scrambled_sobol2(std::uint32_t i, std::uint32_t seed0, std
 
 // ---- environment access ----------------------------------------------------------------------
 
-template <class Env> struct rr_env_scalar {
-    using type = std::conditional_t<environment<Env, double>, double, float>;
-};
-template <class Env>
-    requires requires { typename Env::scalar_type; }
-struct rr_env_scalar<Env> {
-    using type = typename Env::scalar_type;
-};
-
 /// Radiance of env at lod 0 in direction d, evaluated in the environment's scalar type.
 template <class Env> vec3<double> rr_radiance(const Env& env, const vec3<double>& d) {
-    using Te = typename rr_env_scalar<Env>::type;
+    using Te = environment_scalar_t<Env>;
     return vec3<double>(vec3<Te>(env.radiance(vec3<Te>(d), Te(0))));
 }
 

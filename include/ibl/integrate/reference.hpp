@@ -55,11 +55,9 @@
 namespace ibl {
 
 namespace detail {
-template <class Env> using env_scalar_t = std::conditional_t<environment<Env, float>, float, double>;
-
 /// Radiance of env at a double direction, as double (the environment's own scalar type inside).
 template <class Env> vec3<double> radiance_d(const Env& env, const vec3<double>& d) {
-    using Te = env_scalar_t<Env>;
+    using Te = environment_scalar_t<Env>;
     return vec3<double>(vec3<Te>(env.radiance(vec3<Te>(d), Te(0))));
 }
 
