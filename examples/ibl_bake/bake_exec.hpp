@@ -35,6 +35,7 @@ public:
         step_ = step;
         label_ = step;
         fraction_ = 0.0;
+        pass_ = 0;
         drawn_ = false;
         t0_ = clock::now();
         last_draw_ = t0_;
@@ -43,7 +44,14 @@ public:
     void label(const std::string& sub) {
         label_ = sub.empty() ? step_ : step_ + " " + sub;
         fraction_ = 0.0;
+        pass_ = 0;
         update(0.0);
+    }
+    /// A new parallel pass (one executor call) of the current step: the fraction restarts and
+    /// the pass number is shown from the second pass on.
+    void next_pass() {
+        ++pass_;
+        fraction_ = 0.0;
     }
     /// Called from the main thread only.
     void update(double fraction) {
@@ -59,7 +67,8 @@ public:
         std::string bar(std::size_t(width), ' ');
         for (int i = 0; i < fill; ++i) bar[std::size_t(i)] = '=';
         if (fill < width) bar[std::size_t(fill)] = '>';
-        std::fprintf(stderr, "\r\033[K  %-28s [%s] %3d%%  %.1f s", label_.c_str(), bar.c_str(), int(100.0 * fraction),
+        const std::string shown = pass_ > 1 ? label_ + " pass " + std::to_string(pass_) : label_;
+        std::fprintf(stderr, "\r\033[K  %-34s [%s] %3d%%  %.1f s", shown.c_str(), bar.c_str(), int(100.0 * fraction),
                      seconds());
         std::fflush(stderr);
     }
@@ -84,6 +93,7 @@ private:
     bool enabled_, tty_, drawn_ = false;
     std::string step_, label_;
     double fraction_ = 0.0;
+    int pass_ = 0;
     clock::time_point t0_{}, last_draw_{};
 };
 
@@ -95,6 +105,7 @@ public:
 
     template <class F> void operator()(std::size_t count, F&& fn) const {
         if (count == 0) return;
+        if (progress_) progress_->next_pass();
         const std::size_t workers = std::min<std::size_t>(threads_, count);
         const std::size_t chunk = std::max<std::size_t>(1, count / (16 * workers));
         std::atomic<std::size_t> next{0}, done{0};

@@ -8,8 +8,8 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <regex>
 #include <stdexcept>
+#include <string_view>
 #include <system_error>
 
 namespace fs = std::filesystem;
@@ -17,6 +17,20 @@ namespace fs = std::filesystem;
 namespace ibl_bake {
 
 namespace {
+/// True for "specular_l<digits>_<face>.exr" (the per-level faces ibl-bake writes).
+bool is_level_face(std::string_view n) {
+    constexpr std::string_view prefix = "specular_l";
+    if (n.substr(0, prefix.size()) != prefix) return false;
+    std::size_t i = prefix.size();
+    const std::size_t digits = i;
+    while (i < n.size() && n[i] >= '0' && n[i] <= '9') ++i;
+    if (i == digits) return false;
+    const std::string_view rest = n.substr(i);
+    for (const std::string_view f : {"_px.exr", "_nx.exr", "_py.exr", "_ny.exr", "_pz.exr", "_nz.exr"})
+        if (rest == f) return true;
+    return false;
+}
+
 fs::path normalized(const std::string& dir) {
     fs::path p = fs::absolute(fs::path(dir)).lexically_normal();
     if (!p.has_filename() && p.has_parent_path()) p = p.parent_path(); // "out/" -> "out"
@@ -40,7 +54,11 @@ output_stage::output_stage(const std::string& dir) : dir_(normalized(dir).string
     std::error_code ec;
     fs::create_directories(parent, ec);
     if (ec) throw std::runtime_error(parent.string() + ": cannot create the parent directory: " + ec.message());
-    std::string tmpl = (parent / ("." + target.filename().string() + ".ibl-bake-XXXXXX")).string();
+    // (built with append, not "." + s: g++ 12 -O3 flags operator+(const char*, string&&) with a
+    // false -Wrestrict)
+    std::string name(1, '.');
+    name.append(target.filename().string()).append(".ibl-bake-XXXXXX");
+    const std::string tmpl = (parent / name).string();
     std::vector<char> buf(tmpl.begin(), tmpl.end());
     buf.push_back('\0');
     if (!::mkdtemp(buf.data()))
@@ -75,10 +93,9 @@ void output_stage::commit() {
             throw std::runtime_error(to.string() + ": cannot move into place: " + std::strerror(errno));
     }
     // Stale per-level faces of an earlier, longer chain.
-    static const std::regex level_face(R"(specular_l[0-9]+_(px|nx|py|ny|pz|nz)\.exr)");
     for (const auto& entry : fs::directory_iterator(target, ec)) {
         const std::string n = entry.path().filename().string();
-        if (std::regex_match(n, level_face) && std::find(names_.begin(), names_.end(), n) == names_.end())
+        if (is_level_face(n) && std::find(names_.begin(), names_.end(), n) == names_.end())
             fs::remove(entry.path(), ec);
     }
     fs::remove_all(staging_, ec);
