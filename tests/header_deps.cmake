@@ -1,0 +1,95 @@
+# tests/header_deps.cmake — the include-dependency rules of the library's layers (issue 7: pay
+# only for what you include). For each umbrella / top-level header, the compiler's dependency
+# list (-M: every file the preprocessor opens) must contain only ibl headers under the allowed
+# prefixes. A layer that starts including a higher one (sh/ pulling in integrate/ prefilter code,
+# brdf/ pulling in sampling/) fails this test. The rules (docs/ARCHITECTURE.md, "Dependency rules"):
+#
+#   ibl/core.hpp      core/
+#   ibl/brdf.hpp      core/ brdf/                       (no sampling/: sampling sits above brdf)
+#   ibl/sampling.hpp  core/ brdf/ sampling/
+#   ibl/env.hpp       core/ env/                        (no integrate/, sh/, batch/)
+#   ibl/sh.hpp        core/ sh/ env/cube_geometry.hpp   (no integrate/, batch/: no prefilter code)
+#   ibl/shade.hpp     core/ brdf/                       (takes products as values, bakes nothing)
+#   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
+#
+# usage: cmake -DCXX=<compiler> -DINCLUDE_DIR=<repo>/include -DGLM_INCLUDE=<dirs;...>
+#              -DWORK_DIR=<scratch dir> -P header_deps.cmake
+cmake_minimum_required(VERSION 3.21)
+
+set(rules
+    "core.hpp|core/"
+    "brdf.hpp|core/ brdf/"
+    "sampling.hpp|core/ brdf/ sampling/"
+    "env.hpp|core/ env/"
+    "sh.hpp|core/ sh/ env/cube_geometry.hpp"
+    "shade.hpp|core/ brdf/"
+    "plan.hpp|core/ integrate/roughness_mip.hpp")
+
+file(MAKE_DIRECTORY ${WORK_DIR})
+file(REAL_PATH ${INCLUDE_DIR}/ibl IBL_DIR)
+set(glm_flags "")
+foreach(d IN LISTS GLM_INCLUDE)
+    if(d)
+        list(APPEND glm_flags "-I${d}")
+    endif()
+endforeach()
+set(failed 0)
+foreach(rule IN LISTS rules)
+    string(REPLACE "|" ";" parts "${rule}")
+    list(GET parts 0 header)
+    list(GET parts 1 allowed)
+    string(REPLACE " " ";" allowed "${allowed}")
+    string(MAKE_C_IDENTIFIER ${header} id)
+    set(tu ${WORK_DIR}/${id}.cpp)
+    file(WRITE ${tu} "#include <ibl/${header}>\n")
+    execute_process(COMMAND ${CXX} -std=c++20 -I${INCLUDE_DIR} ${glm_flags} -M ${tu}
+                    OUTPUT_VARIABLE deps ERROR_VARIABLE err RESULT_VARIABLE rc)
+    if(NOT rc EQUAL 0)
+        message(SEND_ERROR "ibl/${header}: preprocessing failed:\n${err}")
+        set(failed 1)
+        continue()
+    endif()
+    string(REPLACE "\\\n" " " deps "${deps}")
+    string(REGEX REPLACE "[ \t\r\n]+" ";" deps "${deps}")
+    set(bad "")
+    set(seen 0)
+    foreach(dep IN LISTS deps)
+        if(NOT dep MATCHES "\\.(hpp|h)$")
+            continue()
+        endif()
+        file(REAL_PATH ${dep} real)
+        string(FIND "${real}" "${IBL_DIR}/" pos)
+        if(NOT pos EQUAL 0)
+            continue() # not an ibl header (GLM, the standard library)
+        endif()
+        string(LENGTH "${IBL_DIR}/" plen)
+        string(SUBSTRING "${real}" ${plen} -1 rel)
+        math(EXPR seen "${seen} + 1")
+        if(rel STREQUAL header)
+            continue()
+        endif()
+        set(ok 0)
+        foreach(prefix IN LISTS allowed)
+            string(FIND "${rel}" "${prefix}" p)
+            if(p EQUAL 0)
+                set(ok 1)
+            endif()
+        endforeach()
+        if(NOT ok)
+            list(APPEND bad ${rel})
+        endif()
+    endforeach()
+    if(seen EQUAL 0)
+        message(SEND_ERROR "ibl/${header}: no ibl header in the dependency list (the check is broken)")
+        set(failed 1)
+    elseif(bad)
+        list(REMOVE_DUPLICATES bad)
+        message(SEND_ERROR "ibl/${header} may include only [${allowed}] but pulls in: ${bad}")
+        set(failed 1)
+    else()
+        message(STATUS "ibl/${header}: ${seen} ibl headers, all within [${allowed}]")
+    endif()
+endforeach()
+if(failed)
+    message(FATAL_ERROR "header dependency rules violated")
+endif()
