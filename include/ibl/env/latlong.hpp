@@ -61,7 +61,12 @@ template <class T> IBL_FUNC vec2<T> latlong_uv(const vec3<T>& dir) noexcept {
     using std::atan2;
     using std::sqrt;
     const T u = T(0.5) + atan2(dir.z, dir.x) * inv_two_pi_v<T>;
-    const T v = T(0.5) + atan2(dir.y, sqrt(dir.x * dir.x + dir.z * dir.z)) * inv_pi_v<T>;
+    // v = 0.5 + asin(y)/pi written as (polar angle from -Y)/pi: atan2(0, 1) = 0 and
+    // atan2(0, -1) = pi_T make both poles exact (v = 0 and 1) in any rounding/contraction mode,
+    // and atan2 keeps full accuracy near the poles where asin(y) would not.
+    // The zero vector (and NaN) maps to the equator, v = 0.5, as before.
+    const T r = sqrt(dir.x * dir.x + dir.z * dir.z);
+    const T v = (r > T(0) || dir.y != T(0)) ? atan2(r, -dir.y) / pi_v<T> : T(0.5);
     return {u, v};
 }
 
