@@ -79,6 +79,12 @@ bake_options parse_options(const std::vector<std::string>& args) {
         } else if (name == "--quiet") {
             flag();
             o.quiet = true;
+        } else if (name == "--scene") {
+            o.scene = take();
+            if (o.scene.empty()) throw usage_error("--scene: empty path");
+        } else if (name == "--compare-full") {
+            flag();
+            o.compare_full = true;
         } else if (name == "--input") {
             o.input = take();
             if (o.input.empty()) throw usage_error("--input: empty path");
@@ -111,6 +117,7 @@ bake_options parse_options(const std::vector<std::string>& args) {
     }
     if (o.help || o.version) return o;
     if (!have_out) throw usage_error("--out DIR is required");
+    if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.levels > 0) {
         int full = 1;
         while ((o.size >> full) > 0) ++full;
@@ -134,6 +141,8 @@ std::string usage_text() {
            "  --quality Q        low | default | high\n"
            "  --ktx2-format F    f16 (default) | f32\n"
            "  --quiet            no progress on stderr\n"
+           "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
+           "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --help, --version\n";
 }
 

@@ -12,6 +12,7 @@
 
 #include "bake_options.hpp"
 #include "bake_pipeline.hpp"
+#include "bake_scene.hpp"
 
 int main(int argc, char** argv) {
     using namespace ibl_bake;
@@ -31,7 +32,8 @@ int main(int argc, char** argv) {
         return 0;
     }
     try {
-        run_bake(opt, stdout);
+        if (!opt.scene.empty()) run_scene_bake(opt, stdout);
+        else run_bake(opt, stdout);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "ibl-bake: error: %s\n", e.what());
         return 1;

@@ -1,0 +1,177 @@
+// examples/ibl_bake/plan_measure.cpp — the measurements behind the decision tables of
+// include/ibl/plan.hpp (issue 7). Run it after changing an integrator and update the tables.
+//
+//   1. DFG LUT: the largest bilinear-interpolation error of an exact N^2 table (clamp-to-edge, as
+//      a GPU samples it) against dfg_exact at off-grid points, N = 16 .. 256. The points are a
+//      257 x 257 grid over [0, 1]^2 offset by half a cell of the finest table (so no point is a
+//      texel centre), every domain edge included (n.v = 0 and r = 0 lie outside the texel centres:
+//      clamp-to-edge extrapolates there, which is what a shader reads).
+//   2. SH irradiance: 2 bands against 3 bands, error of the irradiance against a brute-force
+//      cosine integral of the same 64^2 cubemap (every texel, exact solid angles), at the texel
+//      centres of a 16 x 16-per-face cube, normalised by the RMS / the largest irradiance (see
+//      sh_err); default sky + sun and the test HDRs.
+//   3. Specular prefilter (filtered importance sampling, nearest-level reads, lod bias 0.5): the
+//      normalised RMSE (RMSE / RMS of the reference) of levels of roughness r against
+//      reference_ld_sky on the default sky + sun, for N = 16 .. 1024 samples, at a 64^2 base
+//      (bench/bench_prefilter.cpp has the 256^2-base sweep; both feed plan.hpp's constant).
+//
+// usage: ibl_plan_measure [dfg] [sh] [prefilter]     (default: all)
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include <ibl/brdf/model.hpp>
+#include <ibl/core/executor.hpp>
+#include <ibl/env/analytic.hpp>
+#include <ibl/env/convert.hpp>
+#include <ibl/env/latlong.hpp>
+#include <ibl/integrate/dfg.hpp>
+#include <ibl/integrate/dfg_lut.hpp>
+#include <ibl/integrate/metrics.hpp>
+#include <ibl/integrate/prefilter.hpp>
+#include <ibl/integrate/reference.hpp>
+#include <ibl/sh/convolve.hpp>
+#include <ibl/sh/project.hpp>
+
+#include "image_io.hpp"
+
+namespace {
+
+using dvec3 = ibl::vec3<double>;
+using model = ibl::ggx_height_correlated;
+
+void measure_dfg() {
+    std::printf("DFG LUT (%s): bilinear error of an exact N^2 table against dfg_exact, 257^2 off-grid points\n",
+                model::name);
+    std::printf("%6s %12s %12s %14s\n", "N", "max |dA|,|dB|", "rms", "max (n.v>=0.1)");
+    constexpr int g = 257;
+    std::vector<ibl::vec2<double>> ref(std::size_t(g) * g);
+    std::vector<double> xs(g);
+    for (int i = 0; i < g; ++i) xs[std::size_t(i)] = std::min(1.0, (double(i) + 0.5 / 256.0) / double(g - 1));
+    ibl::thread_executor{}(std::size_t(g) * g, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) ref[k] = ibl::dfg_exact<model>(xs[k % g], xs[k / g]);
+    });
+    for (std::uint32_t n : {16u, 32u, 64u, 128u, 256u}) {
+        const ibl::dfg_lut lut = ibl::make_dfg_lut_exact<model>(n, 2);
+        double mx = 0, ss = 0, mx_inner = 0;
+        for (std::size_t k = 0; k < ref.size(); ++k) {
+            const ibl::vec3<float> s = lut.sample(float(xs[k % g]), float(xs[k / g]));
+            const double d = std::max(std::fabs(s.x - ref[k].x), std::fabs(s.y - ref[k].y));
+            mx = std::max(mx, d);
+            ss += d * d;
+            if (xs[k % g] >= 0.1) mx_inner = std::max(mx_inner, d);
+        }
+        std::printf("%6u %12.3e %12.3e %14.3e\n", n, mx, std::sqrt(ss / double(ref.size())), mx_inner);
+    }
+}
+
+/// Per band count: nrmse = RMS(E_sh - E) / RMS(E) and max = max |E_sh - E| / max E (channel
+/// sums): the error relative to the scale of the irradiance, not to each normal's own E (which
+/// is tiny facing away from a sun, where a relative error says nothing about what is seen).
+struct sh_err {
+    double nrmse2 = 0, max2 = 0, nrmse3 = 0, max3 = 0;
+};
+
+sh_err sh_errors(const ibl::cubemap<float>& cube) {
+    std::vector<dvec3> normals;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < 16; ++y)
+            for (int x = 0; x < 16; ++x) normals.push_back(ibl::cube_texel_direction<double>(f, x, y, 16));
+    const int n = cube.size(0);
+    std::vector<dvec3> dir, rad;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                dir.push_back(ibl::cube_texel_direction<double>(f, x, y, n));
+                rad.push_back(dvec3(cube.texel(f, x, y, 0)) * ibl::cube_texel_solid_angle<double>(x, y, n));
+            }
+    std::vector<dvec3> ref(normals.size());
+    ibl::thread_executor{}(normals.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            dvec3 s(0);
+            for (std::size_t t = 0; t < dir.size(); ++t) s += rad[t] * std::max(0.0, glm::dot(normals[i], dir[t]));
+            ref[i] = s;
+        }
+    });
+    const auto c3 = ibl::project_cube<3>(
+        n, [&](int f, int x, int y) { return dvec3(cube.texel(f, x, y, 0)); }, ibl::thread_executor{});
+    const auto c2 = ibl::project_cube<2>(
+        n, [&](int f, int x, int y) { return dvec3(cube.texel(f, x, y, 0)); }, ibl::thread_executor{});
+    sh_err r;
+    double ss_ref = 0, max_ref = 0;
+    for (std::size_t i = 0; i < normals.size(); ++i) {
+        const double er = ref[i].x + ref[i].y + ref[i].z;
+        const dvec3 e2 = ibl::sh_irradiance_at(c2, normals[i]), e3 = ibl::sh_irradiance_at(c3, normals[i]);
+        const double d2 = e2.x + e2.y + e2.z - er, d3 = e3.x + e3.y + e3.z - er;
+        ss_ref += er * er;
+        max_ref = std::max(max_ref, er);
+        r.nrmse2 += d2 * d2;
+        r.nrmse3 += d3 * d3;
+        r.max2 = std::max(r.max2, std::fabs(d2));
+        r.max3 = std::max(r.max3, std::fabs(d3));
+    }
+    r.nrmse2 = std::sqrt(r.nrmse2 / ss_ref);
+    r.nrmse3 = std::sqrt(r.nrmse3 / ss_ref);
+    r.max2 /= max_ref;
+    r.max3 /= max_ref;
+    return r;
+}
+
+void measure_sh() {
+    std::printf("\nSH irradiance vs brute force (64^2 cube, 1536 normals): RMS(dE)/RMS(E), max|dE|/max E\n");
+    std::printf("%-22s %10s %10s %10s %10s\n", "environment", "2b nrmse", "2b max", "3b nrmse", "3b max");
+    auto row = [](const char* name, const sh_err& e) {
+        std::printf("%-22s %10.4f %10.4f %10.4f %10.4f\n", name, e.nrmse2, e.max2, e.nrmse3, e.max3);
+    };
+    row("default sky + sun", sh_errors(ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), 64, 16, ibl::thread_executor{}, 1)));
+    for (const char* file : {"courtyard.exr", "studio.exr"}) {
+        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(std::string(IBL_PLAN_DATA_DIR) + "/" + file);
+        const ibl::latlong<float> ll(img.width, img.height, std::span<const float>(img.rgb), 1);
+        row(file, sh_errors(ibl::latlong_to_cubemap(ll, 64, 4, ibl::thread_executor{}, 1)));
+    }
+}
+
+void measure_prefilter() {
+    constexpr int base = 64, levels = 5;
+    std::printf("\nPrefilter FIS (nearest level, bias 0.5), %d^2 base, %d levels, default sky + sun: nrmse per level\n",
+                base, levels);
+    const auto sky = ibl::make_default_sky<double>();
+    const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), base, 8, ibl::thread_executor{}, 0);
+    const ibl::roughness_mip_policy policy{};
+    std::vector<std::vector<dvec3>> ref(levels);
+    for (int l = 1; l < levels; ++l) {
+        const double r = policy.roughness(double(l), levels);
+        ref[std::size_t(l)] = ibl::reference_faces(
+            base >> l, [&](const dvec3& d) { return ibl::reference_ld_sky(sky, d, r, 2048, 16); }, ibl::thread_executor{});
+    }
+    std::printf("%6s", "N");
+    for (int l = 1; l < levels; ++l) std::printf("   r=%.2f  C=e*sqrtN", policy.roughness(double(l), levels));
+    std::printf("\n");
+    for (std::uint32_t n : {16u, 32u, 64u, 128u, 256u, 512u, 1024u}) {
+        ibl::prefilter_options o;
+        o.levels = levels;
+        o.base_size = base;
+        o.samples = n;
+        const ibl::cubemap<float> out = ibl::prefilter(src, o, ibl::thread_executor{});
+        std::printf("%6u", n);
+        for (int l = 1; l < levels; ++l) {
+            const ibl::error_metrics m = ibl::compare_level(out, l, std::span<const dvec3>(ref[std::size_t(l)]));
+            std::printf("   %6.4f  %9.3f", m.nrmse, m.nrmse * std::sqrt(double(n)));
+        }
+        std::printf("\n");
+    }
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::vector<std::string> what(argv + 1, argv + argc);
+    auto want = [&](const char* w) { return what.empty() || std::find(what.begin(), what.end(), w) != what.end(); };
+    if (want("dfg")) measure_dfg();
+    if (want("sh")) measure_sh();
+    if (want("prefilter")) measure_prefilter();
+    return 0;
+}
