@@ -425,6 +425,12 @@ void run_bake(const bake_options& opt, std::FILE* out) {
     po.policy = ibl::roughness_mip_policy::linear();
     po.method = ibl::prefilter_method::filtered_importance;
     po.samples = qs.prefilter_samples;
+    // Level l has 4^-l of the base's texels, so doubling the samples per level keeps each level's
+    // cost falling geometrically (the whole chain costs < 2x level 1) while the rough levels,
+    // where a sun is smeared over many texels and shows as mottle, get many more samples.
+    po.samples_per_level.assign(std::size_t(levels > 0 ? levels : 1), 0u);
+    for (std::size_t l = 1; l < po.samples_per_level.size(); ++l)
+        po.samples_per_level[l] = std::min<std::uint32_t>(qs.prefilter_samples << (l - 1), 16384u);
     po.trilinear = qs.trilinear;
     prog.begin("prefilter");
     const ibl::cubemap<float> chain = ibl::prefilter(source, po, ex);
@@ -496,7 +502,7 @@ void run_bake(const bake_options& opt, std::FILE* out) {
                 worst_over = std::max(worst_over, c.m.max_ratio);
             }
         rows.push_back({"specular chain", std::string("GGX filtered IS") + (qs.trilinear ? " (trilinear)" : ""),
-                        std::to_string(qs.prefilter_samples) + " spp, " + std::to_string(chain_levels) + " levels",
+                        std::to_string(qs.prefilter_samples) + "*2^(l-1) spp, " + std::to_string(chain_levels) + " levels",
                         prefilter_ms,
                         chain_levels > 1 ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) +
                                                fmt(", max overshoot %.3g", worst_over)
