@@ -17,6 +17,7 @@
 //
 // usage: ibl_plan_measure [dfg] [sh] [prefilter]     (default: all)
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,7 +25,9 @@
 #include <vector>
 
 #include <ibl/brdf/model.hpp>
+#include <ibl/core/color.hpp>
 #include <ibl/core/executor.hpp>
+#include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
@@ -134,34 +137,83 @@ void measure_sh() {
     }
 }
 
+/// The texels the per-level check of `ibl-bake --scene --compare-full` reads: a 6 x 6 grid per
+/// face plus the 3 x 3 block at the direction `light` (the sun).
+std::vector<std::array<int, 3>> check_texels(int n, const dvec3& light) {
+    std::vector<std::array<int, 3>> tex;
+    const int g = std::min(6, n);
+    for (int f = 0; f < 6; ++f)
+        for (int j = 0; j < g; ++j)
+            for (int i = 0; i < g; ++i) tex.push_back({f, int((i + 0.5) * n / g), int((j + 0.5) * n / g)});
+    const ibl::cube_coord<double> cc = ibl::cube_lookup(light);
+    for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+            tex.push_back({cc.face, std::clamp(int(cc.s * n) + dx, 0, n - 1), std::clamp(int(cc.t * n) + dy, 0, n - 1)});
+    return tex;
+}
+
+double nrmse_at(const std::vector<dvec3>& a, const std::vector<dvec3>& ref) {
+    ibl::error_accumulator acc(1e-3);
+    for (std::size_t i = 0; i < a.size(); ++i) acc.add(a[i], ref[i]);
+    return acc.finish().nrmse;
+}
+
+/// 3. The chain layouts the plan produces (ibl-bake: 6 virtual levels, linear policy; the plan's
+/// virtual base is 256 when r = 0.2 is read, else 128 for a 256 source), levels r = 0.2 .. 1 at
+/// face size base >> v, source cube baked at the base size with 4 x 4 sub-samples (as ibl-bake).
+/// Per level, read mode (nearest / trilinear) and N: nrmse at the check texels against
+///   conv  the converged level of the same layout (N = 4096, trilinear): what the product target
+///         of the plan refers to (ibl-bake --compare-full's converged set);
+///   ref   reference_ld_sky (the true LD; the floor of filtered IS itself shows here).
 void measure_prefilter() {
-    constexpr int base = 64, levels = 5;
-    std::printf("\nPrefilter FIS (nearest level, bias 0.5), %d^2 base, %d levels, default sky + sun: nrmse per level\n",
-                base, levels);
+    constexpr int levels = 6;
+    const std::vector<std::uint32_t> ns = {64u, 128u, 256u, 512u, 1024u, 2048u, 4096u};
     const auto sky = ibl::make_default_sky<double>();
-    const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), base, 8, ibl::thread_executor{}, 0);
-    const ibl::roughness_mip_policy policy{};
-    std::vector<std::vector<dvec3>> ref(levels);
-    for (int l = 1; l < levels; ++l) {
-        const double r = policy.roughness(double(l), levels);
-        ref[std::size_t(l)] = ibl::reference_faces(
-            base >> l, [&](const dvec3& d) { return ibl::reference_ld_sky(sky, d, r, 2048, 16); }, ibl::thread_executor{});
-    }
-    std::printf("%6s", "N");
-    for (int l = 1; l < levels; ++l) std::printf("   r=%.2f  C=e*sqrtN", policy.roughness(double(l), levels));
-    std::printf("\n");
-    for (std::uint32_t n : {16u, 32u, 64u, 128u, 256u, 512u, 1024u}) {
-        ibl::prefilter_options o;
-        o.levels = levels;
-        o.base_size = base;
-        o.samples = n;
-        const ibl::cubemap<float> out = ibl::prefilter(src, o, ibl::thread_executor{});
-        std::printf("%6u", n);
-        for (int l = 1; l < levels; ++l) {
-            const ibl::error_metrics m = ibl::compare_level(out, l, std::span<const dvec3>(ref[std::size_t(l)]));
-            std::printf("   %6.4f  %9.3f", m.nrmse, m.nrmse * std::sqrt(double(n)));
+    const ibl::roughness_mip_policy policy = ibl::roughness_mip_policy::linear();
+    ibl::thread_executor ex{};
+    for (int base : {256, 128}) {
+        const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), base, 4, ex, 0);
+        dvec3 light(0, 1, 0);
+        double best = -1;
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < base; ++y)
+                for (int x = 0; x < base; ++x)
+                    if (const double l = ibl::luminance(dvec3(src.texel(f, x, y, 0))); l > best)
+                        best = l, light = ibl::cube_texel_direction<double>(f, x, y, base);
+        std::printf("\nPrefilter FIS (bias 0.5), base %d, %d levels (linear), default sky + sun: nrmse per level at the\n"
+                    "--compare-full check texels vs converged (4096 trilinear, same layout) and vs reference_ld_sky\n",
+                    base, levels);
+        for (int v = 1; v < levels; ++v) {
+            const double r = policy.roughness(double(v), levels);
+            const int n = base >> v;
+            const auto tex = check_texels(n, light);
+            std::vector<dvec3> ref(tex.size());
+            ex(tex.size(), [&](std::size_t b, std::size_t e) {
+                for (std::size_t i = b; i < e; ++i)
+                    ref[i] = ibl::reference_ld_sky(sky, ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n), r, 2048, 16);
+            });
+            std::vector<std::vector<dvec3>> got[2];
+            for (int tri = 0; tri < 2; ++tri)
+                for (std::uint32_t N : ns) {
+                    ibl::sphere_sample_table<float> table =
+                        ibl::make_ld_table_for<float>(src, r, N, ibl::prefilter_method::filtered_importance, 0.5);
+                    table.trilinear = tri == 1;
+                    const std::vector<ibl::vec3<float>> t = ibl::convolve_faces(src, table, n, ex);
+                    std::vector<dvec3> at;
+                    for (const auto& k : tex)
+                        at.push_back(dvec3(t[(std::size_t(k[0]) * std::size_t(n) + std::size_t(k[2])) * std::size_t(n) + std::size_t(k[1])]));
+                    got[tri].push_back(std::move(at));
+                }
+            const std::vector<dvec3>& conv = got[1].back();
+            std::printf("level %d r=%.2f size %d: conv-vs-ref %.4f\n  %6s %9s %9s %9s %9s %8s %8s\n", v, r, n, nrmse_at(conv, ref), "N",
+                        "near conv", "tri conv", "near ref", "tri ref", "nc*sqrtN", "tc*sqrtN");
+            for (std::size_t i = 0; i < ns.size(); ++i) {
+                const double nc = nrmse_at(got[0][i], conv), tc = nrmse_at(got[1][i], conv);
+                std::printf("  %6u %9.4f %9.4f %9.4f %9.4f %8.2f %8.2f\n", ns[i], nc, tc, nrmse_at(got[0][i], ref),
+                            nrmse_at(got[1][i], ref), nc * std::sqrt(double(ns[i])), tc * std::sqrt(double(ns[i])));
+            }
+            std::fflush(stdout);
         }
-        std::printf("\n");
     }
 }
 

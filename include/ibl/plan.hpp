@@ -46,19 +46,46 @@
 //   Each level's size is rounded up to a power of two; the virtual base is the largest
 //   size_v << v over the needed levels, capped by plan_settings::max_base_size (the source's size).
 //
-// ---- Specular: samples per level (filtered importance sampling, nearest-level reads) -----------
-//   Measured relation (default sky + 1-degree sun of 3e4, the hardest case we ship; nrmse of each
-//   level against reference_ld_sky): e(r, N) ~ C(r) / sqrt(N), with C(r) the upper envelope of
-//   nrmse * sqrt(N) over N = 16 .. 256 at a 256^2 base (bench/bench_prefilter.cpp,
-//   docs/results/bench_prefilter.json) and a 64^2 base (examples/ibl_bake/plan_measure.cpp):
-//       r      0.25   0.50   0.75   1.00
-//       C(r)   1.86   2.73   3.05   3.64        (linear in r between, C(0.25) below 0.25)
-//   N = ceil16((C(r)/target)^2) in [16, 4096]. Caveat (measured): beyond ~256 samples the error on
-//   the sun stops falling like 1/sqrt(N) (nrmse 0.07 - 0.21 at N = 512 - 1024, 64^2 base): the
-//   fixed Hammersley pattern decides how many samples land on the sun. Targets below
-//   prefilter_sun_floor (0.1) on rough levels are flagged in the warnings: not reliably reachable
-//   with filtered IS on a sky with a sun. A source without a sun converges ~20x faster (C ~ 0.1).
-//
+// ---- Specular: samples and read mode per level (filtered importance sampling) ---------------------
+//   Measured where it is used (examples/ibl_bake/plan_measure.cpp `prefilter`): the chain layouts
+//   the plan produces for a 256 source (6 virtual levels, linear policy, virtual base 256 when
+//   r = 0.2 is read, else 128; level v at face size base >> v; source baked at the base size, 4 x 4
+//   sub-samples), default sky + 1-degree sun of 3e4 (the hardest case we ship). Error of a level:
+//   nrmse at the texels ibl-bake --compare-full checks (6 x 6 per face + the 3 x 3 block at the sun)
+//   against the CONVERGED level of the same layout (4096 samples, trilinear reads: what the target
+//   refers to). Table: the non-increasing upper envelope over N' >= N and over both layouts
+//   (trilinear at 4096 is the converged set itself: its entry is nearest-4096's, the noise left):
+//       nearest    N=64    128    256    512   1024   2048   4096
+//       r = 0.2   0.229  0.067  0.055  0.016  0.014  0.004  0.001
+//       r = 0.4   0.262  0.221  0.221  0.112  0.090  0.035  0.021
+//       r = 0.6   0.428  0.239  0.239  0.239  0.239  0.111  0.070
+//       r = 0.8   0.376  0.252  0.252  0.194  0.194  0.126  0.067
+//       r = 1.0   0.336  0.336  0.270  0.270  0.181  0.179  0.082
+//       trilinear
+//       r = 0.2   0.171  0.092  0.043  0.017  0.010  0.004  0.001
+//       r = 0.4   0.229  0.203  0.203  0.141  0.069  0.038  0.021
+//       r = 0.6   0.307  0.228  0.176  0.153  0.153  0.093  0.070
+//       r = 0.8   0.304  0.239  0.222  0.169  0.169  0.142  0.067
+//       r = 1.0   0.323  0.273  0.229  0.217  0.150  0.120  0.082
+//   Not 1/sqrt(N): e sqrt(N) grows from ~2 (N = 64) to 4 - 8 (N = 1024 - 2048) on rough levels;
+//   fitted on the envelope, e ~ N^-0.5 at r = 0.2 - 0.4 but only ~N^-0.3 at r >= 0.6 (a fixed
+//   Hammersley pattern decides how many samples land on the sun; single N are lucky or unlucky,
+//   hence the envelope). Nearest-level reads are not biased against trilinear ones beyond that
+//   noise (nearest 4096 vs converged: 0.001 - 0.08). Reachable floor (4096 samples): 0.021 at
+//   r = 0.4, 0.07 - 0.08 at r >= 0.6.
+//   Rule: each needed level gets the cheapest (N, read mode), cost N x (2 if trilinear), N in 16 ..
+//   4096 (powers of two), with expected error <= target / prefilter_product_margin(r) (N < 64:
+//   e(64) sqrt(64 / N); r between rows: linear). None: the lowest error is taken and the plan warns
+//   with the smallest target the scene can reach (floor x margin).
+//   Margin: the product error (relative RMS of ambient luminance at the shading points vs the
+//   converged products, what the target is about) against the largest needed level's measured
+//   error, ibl-bake --compare-full, built-in sky (glossy_metals at targets 0.05 - 0.2 and the full
+//   bake; rough_plastics): 0.50 - 1.83 (glossy: trilinear blending of levels 1 and 2 and the bright
+//   metal reflections near the sun weight the sun's error more than the check texels do; rough:
+//   blending and the diffuse share dilute it). Margin by level: 1.83 (the largest measured) for
+//   r < 0.5, whose concentrated sun reflections dominate the product error (measured 0.72 - 1.83);
+//   1.0 for r >= 0.5 (measured 0.49 on rough_plastics: no credit taken for the dilution).
+
 // ---- Diffuse -------------------------------------------------------------------------------------
 //   None when diffuse is not lit by IBL or every material is a bare metal (metallic = 1). Else SH:
 //   measured RMS(E_SH - E)/RMS(E) of 2 and 3 bands against a brute-force cosine integral of the
@@ -156,6 +183,7 @@ struct specular_level_plan {
     double roughness = 0.0;     ///< policy.roughness(v, L)
     std::uint32_t samples = 0;  ///< 0 for the mirror level (a copy of the source)
     bool needed = true;         ///< read by some used roughness (false: contiguity filler)
+    bool trilinear = false;     ///< prefilter reads of this level (nearest level or trilinear)
     double expected_error = 0.0;
 };
 
@@ -165,7 +193,7 @@ struct specular_plan {
     int virtual_levels = 1;
     int virtual_base_size = 1;
     int first_level = 0;
-    bool trilinear = false;     ///< prefilter reads (nearest level: the cheaper at equal error)
+    bool trilinear = false;     ///< true when every baked level reads trilinearly (per level: specular_level_plan)
     std::vector<specular_level_plan> levels; ///< stored levels, sharpest first
 
     /// The lod to sample the stored chain at for roughness r.
@@ -209,18 +237,75 @@ struct bake_plan {
 
 // ---- measured relations (sources in the header) ------------------------------------------------------
 
-/// Filtered-IS constant C(r) of e ~ C / sqrt(N) on the default sky + sun.
-[[nodiscard]] inline double prefilter_error_constant(double roughness) noexcept {
-    constexpr double r_at[4] = {0.25, 0.5, 0.75, 1.0};
-    constexpr double c_at[4] = {1.86, 2.73, 3.05, 3.64};
-    const double r = std::clamp(roughness, 0.0, 1.0);
-    if (r <= r_at[0]) return c_at[0];
-    for (int i = 1; i < 4; ++i)
-        if (r <= r_at[i]) return c_at[i - 1] + (c_at[i] - c_at[i - 1]) * (r - r_at[i - 1]) / (r_at[i] - r_at[i - 1]);
-    return c_at[3];
+/// Measured filtered-IS error of one level (plan_measure.cpp, header table): roughness rows, sample
+/// columns, nearest-level and trilinear reads; the non-increasing upper envelope over the two
+/// chain layouts the plan produces.
+inline constexpr double prefilter_table_r[5] = {0.2, 0.4, 0.6, 0.8, 1.0};
+inline constexpr std::uint32_t prefilter_table_n[7] = {64, 128, 256, 512, 1024, 2048, 4096};
+inline constexpr double prefilter_error_nearest[5][7] = {
+    {0.229, 0.067, 0.055, 0.016, 0.014, 0.004, 0.001}, {0.262, 0.221, 0.221, 0.112, 0.090, 0.035, 0.021},
+    {0.428, 0.239, 0.239, 0.239, 0.239, 0.111, 0.070}, {0.376, 0.252, 0.252, 0.194, 0.194, 0.126, 0.067},
+    {0.336, 0.336, 0.270, 0.270, 0.181, 0.179, 0.082}};
+inline constexpr double prefilter_error_trilinear[5][7] = {
+    {0.171, 0.092, 0.043, 0.017, 0.010, 0.004, 0.001}, {0.229, 0.203, 0.203, 0.141, 0.069, 0.038, 0.021},
+    {0.307, 0.228, 0.176, 0.153, 0.153, 0.093, 0.070}, {0.304, 0.239, 0.222, 0.169, 0.169, 0.142, 0.067},
+    {0.323, 0.273, 0.229, 0.217, 0.150, 0.120, 0.082}};
+/// Product error (ambient luminance at shading points) per unit of a needed level's error, measured
+/// with ibl-bake --compare-full (header): a level of roughness r must meet target / margin(r).
+inline constexpr double prefilter_product_margin_sharp = 1.83; ///< levels r < 0.5 (measured 0.72 - 1.83)
+inline constexpr double prefilter_product_margin_rough = 1.0;  ///< levels r >= 0.5 (measured 0.49; no credit taken)
+[[nodiscard]] inline double prefilter_product_margin(double roughness) noexcept {
+    return roughness < 0.5 ? prefilter_product_margin_sharp : prefilter_product_margin_rough;
 }
-/// Targets below this are not reliably met by filtered IS on a sky with a sun (see the header).
-inline constexpr double prefilter_sun_floor = 0.1;
+
+/// Expected error (nrmse vs converged) of a level of roughness r baked with N samples per texel.
+/// Between table rows: linear in r (below 0.2: the 0.2 row); between columns: the value at the
+/// largest tabulated N <= N (the envelope is non-increasing); below 64: e(64) sqrt(64 / N);
+/// above 4096: e(4096) (the floor: not measured beyond).
+[[nodiscard]] inline double prefilter_expected_error(double roughness, std::uint32_t samples, bool trilinear) noexcept {
+    const auto& t = trilinear ? prefilter_error_trilinear : prefilter_error_nearest;
+    const double r = std::clamp(roughness, prefilter_table_r[0], prefilter_table_r[4]);
+    int i = 0;
+    while (i < 3 && r > prefilter_table_r[i + 1]) ++i;
+    const double w = (r - prefilter_table_r[i]) / (prefilter_table_r[i + 1] - prefilter_table_r[i]);
+    const std::uint32_t n = std::max<std::uint32_t>(samples, 1u);
+    int j = 0;
+    while (j < 6 && prefilter_table_n[j + 1] <= n) ++j;
+    const double scale = n < prefilter_table_n[0] ? std::sqrt(double(prefilter_table_n[0]) / double(n)) : 1.0;
+    return scale * ((1.0 - w) * t[i][j] + w * t[i + 1][j]);
+}
+
+/// The cheapest (samples, read mode) of a level whose expected error is within `level_target`;
+/// cost = samples x (2 if trilinear). met = false: nothing within max_samples reaches it (then the
+/// smallest expected error is chosen).
+struct prefilter_choice {
+    std::uint32_t samples = 16;
+    bool trilinear = false;
+    double expected_error = 0.0;
+    bool met = false;
+};
+[[nodiscard]] inline prefilter_choice choose_prefilter(double roughness, double level_target, std::uint32_t max_samples = 4096) {
+    constexpr std::uint32_t grid[9] = {16, 32, 64, 128, 256, 512, 1024, 2048, 4096};
+    prefilter_choice best, lowest;
+    double best_cost = 0.0;
+    lowest.expected_error = 1e300;
+    for (std::uint32_t n : grid) {
+        if (n > std::max<std::uint32_t>(max_samples, 16u)) break;
+        for (bool tri : {false, true}) {
+            const double e = prefilter_expected_error(roughness, n, tri), cost = double(n) * (tri ? 2.0 : 1.0);
+            if (e < lowest.expected_error) lowest = {n, tri, e, false};
+            if (e <= level_target && (!best.met || cost < best_cost || (cost == best_cost && e < best.expected_error))) {
+                best = {n, tri, e, true};
+                best_cost = cost;
+            }
+        }
+    }
+    return best.met ? best : lowest;
+}
+/// The smallest error the table reaches at roughness r (4096 samples or max_samples).
+[[nodiscard]] inline double prefilter_reachable_error(double roughness, std::uint32_t max_samples = 4096) {
+    return choose_prefilter(roughness, 0.0, max_samples).expected_error;
+}
 
 /// Largest bilinear error of an exact N^2 DFG table (n.v >= 0.1), N in dfg_sizes.
 inline constexpr int dfg_sizes[5] = {16, 32, 64, 128, 256};
@@ -261,11 +346,9 @@ inline std::string fmt_num(double v) {
     return std::min(detail::pow2_ceil(n), cap);
 }
 
-/// Filtered-IS samples per texel meeting `target` at roughness r (header: N = ceil16((C/e)^2)).
+/// Filtered-IS samples per texel of the cheapest choice meeting `target` at roughness r.
 [[nodiscard]] inline std::uint32_t prefilter_samples_for(double roughness, double target, std::uint32_t max_samples = 4096) {
-    const double c = prefilter_error_constant(roughness);
-    const double n = std::clamp((c / target) * (c / target), 16.0, double(max_samples));
-    return std::min(detail::ceil16(n), std::max<std::uint32_t>(max_samples, 16u));
+    return choose_prefilter(roughness, target, max_samples).samples;
 }
 
 /// Smallest DFG size whose interpolation error is within target / 8 (256 if none).
@@ -289,7 +372,7 @@ inline std::string fmt_num(double v) {
     c.source_ms = 6.0 * double(p.source_size) * double(p.source_size) * k2 * ns_source * 1e-6;
     if (p.specular.enabled)
         for (const auto& l : p.specular.levels)
-            c.specular_ms += 6.0 * double(l.size) * double(l.size) * double(l.samples) * (p.specular.trilinear ? 2.0 : 1.0) *
+            c.specular_ms += 6.0 * double(l.size) * double(l.size) * double(l.samples) * (l.trilinear ? 2.0 : 1.0) *
                              ns_tap * 1e-6;
     if (p.diffuse.kind == diffuse_product::sh)
         c.diffuse_ms = 6.0 * double(p.source_size) * double(p.source_size) * ns_sh_texel * 1e-6;
@@ -359,7 +442,6 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
     sp.policy = set.policy;
     sp.virtual_levels = L;
     sp.first_level = first;
-    sp.trilinear = false;
     const int screen_cap = std::max(1, s.max_reflection_pixels / 2);
     int base = 1;
     for (int v = first; v <= last; ++v) {
@@ -370,7 +452,8 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
     }
     base = std::min(base, set.max_base_size);
     sp.virtual_base_size = base;
-    bool sun_floor_warned = false;
+    double worst_reachable = 0.0;
+    bool all_tri = true;
     for (int v = first; v <= last; ++v) {
         specular_level_plan lp;
         lp.level = v;
@@ -380,21 +463,30 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
         if (v == 0) {
             lp.samples = 0; // the mirror level: a copy of the source
         } else if (lp.needed) {
-            lp.samples = prefilter_samples_for(lp.roughness, s.error_target, s.limits.max_samples);
-            lp.expected_error = prefilter_error_constant(lp.roughness) / std::sqrt(double(lp.samples));
-            if (lp.expected_error > s.error_target * 1.0001)
-                p.warnings.push_back("specular level " + std::to_string(v) + ": max_samples " + std::to_string(s.limits.max_samples) +
-                                     " gives ~" + detail::fmt_num(lp.expected_error) + " > target");
-            if (s.error_target < prefilter_sun_floor && lp.roughness >= 0.5 && !sun_floor_warned) {
-                p.warnings.push_back("specular: target " + detail::fmt_num(s.error_target) + " is below the measured floor (~" +
-                                     detail::fmt_num(prefilter_sun_floor) + ") of filtered IS on rough levels under a sun");
-                sun_floor_warned = true;
+            const double margin = prefilter_product_margin(lp.roughness), level_target = s.error_target / margin;
+            const prefilter_choice c = choose_prefilter(lp.roughness, level_target, s.limits.max_samples);
+            lp.samples = c.samples;
+            lp.trilinear = c.trilinear;
+            lp.expected_error = c.expected_error;
+            if (!c.met) {
+                p.warnings.push_back("specular level " + std::to_string(v) + " (r=" + detail::fmt_num(lp.roughness) + "): target " +
+                                     detail::fmt_num(s.error_target) + " needs level error <= " + detail::fmt_num(level_target) +
+                                     " (margin " + detail::fmt_num(margin) + "), below the reachable ~" +
+                                     detail::fmt_num(c.expected_error) + " (" + std::to_string(c.samples) +
+                                     (c.trilinear ? " trilinear" : " nearest") + " samples, sky + sun)");
+                worst_reachable = std::max(worst_reachable, c.expected_error * margin);
             }
         } else {
             lp.samples = set.filler_samples;
         }
+        if (v > 0) all_tri = all_tri && lp.trilinear;
         sp.levels.push_back(lp);
     }
+    sp.trilinear = all_tri && sp.levels.size() > 1;
+    if (worst_reachable > 0.0)
+        p.warnings.push_back("specular: the smallest reachable target for this scene is ~" +
+                             detail::fmt_num(worst_reachable) +
+                             " (filtered IS on a sky with a sun; the full bake is not better)");
     p.source_size = base;
 
     // Diffuse.
@@ -456,6 +548,7 @@ inline bake_plan full_bake_plan(const plan_settings& set = {}, std::uint32_t sam
         lp.size = std::max(1, set.max_base_size >> v);
         lp.roughness = set.policy.roughness(double(v), set.levels);
         lp.samples = v == 0 ? 0u : samples;
+        lp.trilinear = trilinear;
         sp.levels.push_back(lp);
     }
     p.diffuse = {diffuse_product::sh, 3, 0, 0, sh3_irradiance_error};
