@@ -225,15 +225,7 @@ public:
             for (int f = 0; f < 6; ++f)
                 for (int y = 0; y < n; ++y)
                     for (int x = 0; x < n; ++x) {
-                        vec3<T>& v = data_[index(f, x, y, l)];
-                        bool bad = false;
-                        for (int k = 0; k < 3; ++k) {
-                            if (!is_finite(v[k]) || (zero_negative && v[k] < T(0))) {
-                                v[k] = T(0);
-                                bad = true;
-                            }
-                        }
-                        changed += bad ? 1 : 0;
+                        changed += detail::sanitize_texel(data_[index(f, x, y, l)], zero_negative) ? 1 : 0;
                     }
         }
         update_borders();

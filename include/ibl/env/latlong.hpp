@@ -200,14 +200,7 @@ public:
         for (int l = 0; l < levels(); ++l)
             for (int y = 0; y < height(l); ++y)
                 for (int x = 0; x < width(l); ++x) {
-                    vec3<T>& v = data_[index(x, y, l)];
-                    bool bad = false;
-                    for (int k = 0; k < 3; ++k)
-                        if (!is_finite(v[k]) || (zero_negative && v[k] < T(0))) {
-                            v[k] = T(0);
-                            bad = true;
-                        }
-                    changed += bad ? 1 : 0;
+                    changed += detail::sanitize_texel(data_[index(x, y, l)], zero_negative) ? 1 : 0;
                 }
         update_borders();
         return changed;

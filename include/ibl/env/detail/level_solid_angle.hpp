@@ -1,7 +1,9 @@
 #pragma once
-// ibl/env/detail/level_solid_angle.hpp — the continuous lod <-> texel-solid-angle map shared by
-// cubemap and latlong. `levels` is a contiguous range of per-level records with members `omega`
-// (mean texel solid angle of the level) and `log2_omega`; between whole levels the solid angle is
+// ibl/env/detail/level_solid_angle.hpp — what cubemap and latlong share: the continuous
+// lod <-> texel-solid-angle map, and the per-texel sanitize policy.
+//
+// `levels` is a contiguous range of per-level records with members `omega` (mean texel solid
+// angle of the level) and `log2_omega`; between whole levels the solid angle is
 // interpolated log-linearly, so Omega(lod) = Omega_0 4^lod for a power-of-two chain, and
 // lod_for_solid_angle is its exact inverse.
 
@@ -31,6 +33,18 @@ template <class T, class Levels> T level_lod_for_solid_angle(const Levels& level
         if (x <= b) return T(l) + (x - a) / (b - a);
     }
     return max_lod;
+}
+
+/// Zeroes the non-finite components of a texel (and the negative ones when zero_negative);
+/// returns whether it changed. The texel policy of cubemap::sanitize and latlong::sanitize.
+template <class V> bool sanitize_texel(V& v, bool zero_negative) noexcept {
+    bool bad = false;
+    for (int k = 0; k < 3; ++k)
+        if (!is_finite(v[k]) || (zero_negative && v[k] < decltype(+v[k])(0))) {
+            v[k] = 0;
+            bad = true;
+        }
+    return bad;
 }
 
 } // namespace ibl::detail
