@@ -32,7 +32,6 @@
 #include <span>
 #include <string>
 #include <type_traits>
-#include <variant>
 #include <vector>
 
 #include <unistd.h>
@@ -64,6 +63,7 @@
 #include "bake_stage.hpp"
 #include "image_io.hpp"
 #include "json.hpp"
+#include "json_value.hpp"
 #include "ktx2.hpp"
 
 namespace ibl_bake {
@@ -74,150 +74,22 @@ using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 using model = ibl::ggx_height_correlated;
 
-// ---- a small JSON reader (RFC 8259; numbers as double) --------------------------------------------
+// ---- JSON access (the reader is examples/common/json_value.hpp, shared with bench_plot) ----------
 
-struct jvalue;
-using jobject = std::vector<std::pair<std::string, jvalue>>;
-using jarray = std::vector<jvalue>;
-struct jvalue {
-    std::variant<std::nullptr_t, bool, double, std::string, jarray, jobject> v;
-    const char* type() const {
-        static const char* names[] = {"null", "a boolean", "a number", "a string", "an array", "an object"};
-        return names[v.index()];
-    }
-};
+using ibl_examples::json_value;
+using jarray = std::vector<json_value>;
+using jobject = std::vector<std::pair<std::string, json_value>>;
 
-class jparser {
-public:
-    jparser(const std::string& text, const std::string& source) : s_(text), src_(source) {}
-    jvalue document() {
-        jvalue v = value(0);
-        ws();
-        if (i_ != s_.size()) fail("unexpected text after the JSON value");
-        return v;
+const char* json_type_name(const json_value& v) {
+    switch (v.type) {
+    case json_value::kind::null: return "null";
+    case json_value::kind::boolean: return "a boolean";
+    case json_value::kind::number: return "a number";
+    case json_value::kind::string: return "a string";
+    case json_value::kind::array: return "an array";
+    default: return "an object";
     }
-
-private:
-    const std::string& s_;
-    std::string src_;
-    std::size_t i_ = 0;
-
-    [[noreturn]] void fail(const std::string& what) const {
-        int line = 1, col = 1;
-        for (std::size_t k = 0; k < i_ && k < s_.size(); ++k) {
-            if (s_[k] == '\n') ++line, col = 1;
-            else ++col;
-        }
-        throw scene_error(src_ + ": malformed JSON at line " + std::to_string(line) + ", column " + std::to_string(col) +
-                          ": " + what);
-    }
-    void ws() {
-        while (i_ < s_.size() && (s_[i_] == ' ' || s_[i_] == '\t' || s_[i_] == '\n' || s_[i_] == '\r')) ++i_;
-    }
-    bool eat(char c) {
-        ws();
-        if (i_ < s_.size() && s_[i_] == c) {
-            ++i_;
-            return true;
-        }
-        return false;
-    }
-    void expect(char c) {
-        if (!eat(c)) fail(std::string("expected '") + c + "'");
-    }
-    jvalue value(int depth) {
-        if (depth > 64) fail("nesting deeper than 64");
-        ws();
-        if (i_ >= s_.size()) fail("unexpected end of input");
-        const char c = s_[i_];
-        if (c == '{') return object(depth);
-        if (c == '[') return array(depth);
-        if (c == '"') return {string()};
-        if (s_.compare(i_, 4, "true") == 0) return i_ += 4, jvalue{true};
-        if (s_.compare(i_, 5, "false") == 0) return i_ += 5, jvalue{false};
-        if (s_.compare(i_, 4, "null") == 0) return i_ += 4, jvalue{nullptr};
-        if (c == '-' || (c >= '0' && c <= '9')) return {number()};
-        fail(std::string("unexpected character '") + c + "'");
-    }
-    jvalue object(int depth) {
-        ++i_;
-        jobject o;
-        if (eat('}')) return {o};
-        do {
-            ws();
-            if (i_ >= s_.size() || s_[i_] != '"') fail("expected a key string");
-            std::string k = string();
-            expect(':');
-            o.emplace_back(std::move(k), value(depth + 1));
-        } while (eat(','));
-        expect('}');
-        return {o};
-    }
-    jvalue array(int depth) {
-        ++i_;
-        jarray a;
-        if (eat(']')) return {a};
-        do a.push_back(value(depth + 1));
-        while (eat(','));
-        expect(']');
-        return {a};
-    }
-    std::string string() {
-        ++i_;
-        std::string out;
-        while (true) {
-            if (i_ >= s_.size()) fail("unterminated string");
-            const char c = s_[i_++];
-            if (c == '"') return out;
-            if (static_cast<unsigned char>(c) < 0x20) fail("control character in a string");
-            if (c != '\\') {
-                out += c;
-                continue;
-            }
-            if (i_ >= s_.size()) fail("unterminated escape");
-            const char e = s_[i_++];
-            switch (e) {
-            case '"': out += '"'; break;
-            case '\\': out += '\\'; break;
-            case '/': out += '/'; break;
-            case 'b': out += '\b'; break;
-            case 'f': out += '\f'; break;
-            case 'n': out += '\n'; break;
-            case 'r': out += '\r'; break;
-            case 't': out += '\t'; break;
-            case 'u': { // keep it simple: ASCII escapes only (names need no more)
-                if (i_ + 4 > s_.size()) fail("short \\u escape");
-                const unsigned long cp = std::strtoul(s_.substr(i_, 4).c_str(), nullptr, 16);
-                i_ += 4;
-                out += cp < 0x80 ? char(cp) : '?';
-                break;
-            }
-            default: fail(std::string("bad escape '\\") + e + "'");
-            }
-        }
-    }
-    double number() {
-        const std::size_t b = i_;
-        if (s_[i_] == '-') ++i_;
-        auto digits = [&] {
-            const std::size_t d = i_;
-            while (i_ < s_.size() && s_[i_] >= '0' && s_[i_] <= '9') ++i_;
-            if (i_ == d) fail("expected a digit");
-        };
-        digits();
-        if (i_ < s_.size() && s_[i_] == '.') ++i_, digits();
-        if (i_ < s_.size() && (s_[i_] == 'e' || s_[i_] == 'E')) {
-            ++i_;
-            if (i_ < s_.size() && (s_[i_] == '+' || s_[i_] == '-')) ++i_;
-            digits();
-        }
-        std::istringstream is(s_.substr(b, i_ - b));
-        is.imbue(std::locale::classic());
-        double v = 0;
-        is >> v;
-        return v;
-    }
-};
+}
 
 // ---- scene content ----------------------------------------------------------------------------------
 
@@ -226,34 +98,37 @@ struct scene_reader {
     [[noreturn]] void fail(const std::string& where, const std::string& what) const {
         throw scene_error(src + ": " + where + ": " + what);
     }
-    double number(const jvalue& v, const std::string& where) const {
-        if (const double* d = std::get_if<double>(&v.v)) return *d;
-        fail(where, std::string("expected a number, got ") + v.type());
+    double number(const json_value& v, const std::string& where) const {
+        if (v.is_number()) return v.number;
+        fail(where, std::string("expected a number, got ") + json_type_name(v));
     }
-    bool boolean(const jvalue& v, const std::string& where) const {
-        if (const bool* b = std::get_if<bool>(&v.v)) return *b;
-        fail(where, std::string("expected true or false, got ") + v.type());
+    bool boolean(const json_value& v, const std::string& where) const {
+        if (v.is_bool()) return v.boolean;
+        fail(where, std::string("expected true or false, got ") + json_type_name(v));
     }
-    int integer(const jvalue& v, const std::string& where, int lo, int hi) const {
+    int integer(const json_value& v, const std::string& where, int lo, int hi) const {
         const double d = number(v, where);
         if (d != std::floor(d) || d < lo || d > hi)
             fail(where, "expected an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
         return int(d);
     }
-    std::string string(const jvalue& v, const std::string& where) const {
-        if (const std::string* s = std::get_if<std::string>(&v.v)) return *s;
-        fail(where, std::string("expected a string, got ") + v.type());
+    std::string string(const json_value& v, const std::string& where) const {
+        if (v.is_string()) return v.string;
+        fail(where, std::string("expected a string, got ") + json_type_name(v));
     }
-    const jarray& array(const jvalue& v, const std::string& where) const {
-        if (const jarray* a = std::get_if<jarray>(&v.v)) return *a;
-        fail(where, std::string("expected an array, got ") + v.type());
+    const jarray& array(const json_value& v, const std::string& where) const {
+        if (v.is_array()) return v.values;
+        fail(where, std::string("expected an array, got ") + json_type_name(v));
     }
-    const jobject& object(const jvalue& v, const std::string& where) const {
-        if (const jobject* o = std::get_if<jobject>(&v.v)) return *o;
-        fail(where, std::string("expected an object, got ") + v.type());
+    /// The members of an object in file order (a copy: scene files are small).
+    jobject object(const json_value& v, const std::string& where) const {
+        if (!v.is_object()) fail(where, std::string("expected an object, got ") + json_type_name(v));
+        jobject members;
+        for (std::size_t i = 0; i < v.keys.size(); ++i) members.emplace_back(v.keys[i], v.values[i]);
+        return members;
     }
 
-    ibl::material_class material(const jvalue& v, const std::string& where) const {
+    ibl::material_class material(const json_value& v, const std::string& where) const {
         ibl::material_class m;
         bool have_metallic = false;
         for (const auto& [k, x] : object(v, where)) {
@@ -261,7 +136,7 @@ struct scene_reader {
             if (k == "name") m.name = string(x, w);
             else if (k == "metallic") m.metallic = number(x, w), have_metallic = true;
             else if (k == "roughness") {
-                for (const jvalue& r : array(x, w)) {
+                for (const json_value& r : array(x, w)) {
                     const double d = number(r, w);
                     m.roughness.push_back({d, d});
                 }
@@ -286,7 +161,7 @@ struct scene_reader {
         return m;
     }
 
-    ibl::scene_description scene(const jvalue& root) const {
+    ibl::scene_description scene(const json_value& root) const {
         ibl::scene_description s;
         bool have_materials = false;
         for (const auto& [k, x] : object(root, "scene")) {
@@ -533,7 +408,15 @@ void plan_json(json_writer& j, const ibl::bake_plan& p, const ibl::plan_cost& c)
 } // namespace
 
 ibl::scene_description parse_scene(const std::string& text, const std::string& source) {
-    const jvalue root = jparser(text, source).document();
+    json_value root;
+    try {
+        root = ibl_examples::parse_json(text);
+    } catch (const ibl_examples::json_error& e) { // "line:col: what"
+        const std::string m = e.what();
+        const std::size_t c1 = m.find(':'), c2 = m.find(':', c1 + 1);
+        throw scene_error(source + ": malformed JSON at line " + m.substr(0, c1) + ", column " +
+                          m.substr(c1 + 1, c2 - c1 - 1) + ":" + m.substr(c2 + 1));
+    }
     return scene_reader{source}.scene(root);
 }
 

@@ -18,6 +18,11 @@
 
 namespace bench_plot {
 
+using ibl_examples::json_value;
+using ibl_examples::json_error;
+using ibl_examples::parse_json;
+
+
 struct bench_error : std::runtime_error {
     using std::runtime_error::runtime_error;
 };

@@ -1,4 +1,4 @@
-// json_value.hpp — a small, strict JSON reader for bench_plot (RFC 8259: objects, arrays,
+// json_value.hpp — a small, strict JSON reader shared by the examples (bench_plot, ibl-bake --scene) (RFC 8259: objects, arrays,
 // strings with every escape including \uXXXX surrogate pairs, numbers, true/false/null), plus the
 // four non-standard number spellings Google Benchmark writes for non-finite counters
 // (NaN, -NaN, Infinity, -Infinity). Errors throw json_error with "line:column: what".
@@ -14,7 +14,7 @@
 #include <string_view>
 #include <vector>
 
-namespace bench_plot {
+namespace ibl_examples {
 
 struct json_error : std::runtime_error {
     using std::runtime_error::runtime_error;
@@ -307,4 +307,4 @@ private:
 /// Parses a whole document; throws json_error("line:col: what") on malformed input.
 inline json_value parse_json(std::string_view text) { return detail::json_parser(text).parse_document(); }
 
-} // namespace bench_plot
+} // namespace ibl_examples
