@@ -4,6 +4,7 @@
 #include "core/config.hpp"
 #include "core/constants.hpp"
 #include "core/frame.hpp"
+#include "core/gauss_legendre.hpp"
 #include "core/math.hpp"
 #include "core/sum.hpp"
 #include "core/vec.hpp"

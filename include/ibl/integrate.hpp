@@ -6,7 +6,6 @@
 #include "integrate/dfg_lut.hpp"
 #include "integrate/dfg_multiscatter.hpp"
 #include "integrate/env_importance.hpp"
-#include "integrate/gauss_legendre.hpp"
 #include "integrate/irradiance.hpp"
 #include "integrate/metrics.hpp"
 #include "integrate/prefilter.hpp"

@@ -53,7 +53,7 @@
 #include "../core/vec.hpp"
 #include "../sampling/ggx.hpp"
 #include "../sampling/sequence.hpp"
-#include "gauss_legendre.hpp"
+#include "../core/gauss_legendre.hpp"
 
 namespace ibl {
 

@@ -60,6 +60,7 @@
 #include <utility>
 #include <vector>
 
+#include "../core/gauss_legendre.hpp"
 #include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
@@ -176,40 +177,12 @@ private:
     std::vector<double> f_;
 };
 
-/// Gauss-Legendre nodes and weights on [-1, 1] (n >= 1), by Newton iteration on P_n in double.
-/// Nodes ascend; accuracy about 1 ulp of double for n up to several hundred.
+/// Gauss-Legendre nodes and weights on [-1, 1] (n >= 1; weights sum to 2, nodes ascend):
+/// core/gauss_legendre.hpp's rule.
 inline void gauss_legendre(int n, std::vector<double>& node, std::vector<double>& weight) {
-    node.assign(std::size_t(n), 0.0);
-    weight.assign(std::size_t(n), 0.0);
-    for (int i = 0; i < (n + 1) / 2; ++i) {
-        double t = std::cos(pi_v<double> * (double(i) + 0.75) / (double(n) + 0.5)); // Tricomi's guess
-        double dp = 1;
-        for (int it = 0; it < 100; ++it) {
-            double p0 = 1, p1 = t; // P_0, P_1; Bonnet: (k+1) P_{k+1} = (2k+1) t P_k - k P_{k-1}
-            for (int k = 1; k < n; ++k) {
-                const double p2 = ((2 * k + 1) * t * p1 - k * p0) / (k + 1);
-                p0 = p1;
-                p1 = p2;
-            }
-            dp = n * (t * p1 - p0) / (t * t - 1); // P_n'(t)
-            const double dt = p1 / dp;
-            t -= dt;
-            if (std::fabs(dt) <= 1e-15) break; // quadratic convergence: the last step is exact
-        }
-        // recompute the derivative at the converged node for the weight
-        double p0 = 1, p1 = t;
-        for (int k = 1; k < n; ++k) {
-            const double p2 = ((2 * k + 1) * t * p1 - k * p0) / (k + 1);
-            p0 = p1;
-            p1 = p2;
-        }
-        dp = n == 1 ? 1.0 : n * (t * p1 - p0) / (t * t - 1);
-        const double w = 2 / ((1 - t * t) * dp * dp);
-        node[std::size_t(n - 1 - i)] = t;
-        node[std::size_t(i)] = -t;
-        weight[std::size_t(i)] = weight[std::size_t(n - 1 - i)] = w;
-    }
-    if (n % 2 == 1) node[std::size_t(n / 2)] = 0.0; // exact centre node
+    gauss_legendre_rule r = make_gauss_legendre_symmetric(std::size_t(n));
+    node = std::move(r.x);
+    weight = std::move(r.w);
 }
 
 /// A row of a "latitude ring" source (lat-long row or quadrature ring): directions
