@@ -3,7 +3,7 @@
 #   1. installs missing packages (scripts/deps.sh);
 #   2. configures, builds (warnings are errors) and runs ctest with g++ (preset dev) and clang++
 #      (preset dev-clang); the dev build includes one translation unit per public header (each
-#      header compiles alone) and ctest includes the nvcc device-compile check when nvcc exists;
+#      header compiles alone) and its ctest includes the nvcc device-compile check when nvcc exists;
 #   3. runs the suite once under AddressSanitizer + UndefinedBehaviorSanitizer (preset sanitize);
 #   4. installs the package into a temporary prefix and builds and runs a consumer project that
 #      uses find_package(ibl CONFIG REQUIRED).
