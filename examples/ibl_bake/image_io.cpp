@@ -27,6 +27,7 @@
 #include <fstream>
 #include <limits>
 #include <memory>
+#include <initializer_list>
 #include <string_view>
 #include <system_error>
 
@@ -37,6 +38,11 @@
 #define STB_IMAGE_STATIC
 #define STB_IMAGE_IMPLEMENTATION
 #define STBI_NO_STDIO
+// Only stb's Radiance HDR decoder is compiled in. LDR inputs are recognised by their signature
+// (ldr_format_name below), never parsed: fuzzing (scripts/fuzz.sh) found undefined behaviour in
+// stb's PNM header parser (signed overflow) and JPEG Huffman-table builder (out-of-bounds write)
+// when they only probed arbitrary bytes; regression inputs in examples/ibl_bake/tests/data/fuzz-*.
+#define STBI_ONLY_HDR
 #include <stb_image.h>
 
 #define STB_IMAGE_WRITE_STATIC
@@ -425,6 +431,13 @@ image_rgb32f read_exr_memory(std::span<const unsigned char> bytes, const std::st
     const long long dh = static_cast<long long>(H.data_window.max_y) - H.data_window.min_y + 1;
     check_dimensions(int(std::clamp<long long>(dw, -1, INT_MAX)), int(std::clamp<long long>(dh, -1, INT_MAX)), o, name,
                      "OpenEXR");
+    // tinyexr sizes its offset table from the optional chunkCount attribute before checking it
+    // (a 3 KB file asked for 6.6 GB; found by scripts/fuzz.sh, regression input
+    // examples/ibl_bake/tests/data/fuzz-oom-exr-chunkcount). A scanline image has at most one
+    // chunk per row.
+    if (H.chunk_count < 0 || H.chunk_count > dh)
+        throw image_error(name, "corrupt OpenEXR header (chunkCount " + std::to_string(H.chunk_count) + " for " +
+                                    std::to_string(dh) + " scanlines)");
 
     int idx[3] = {-1, -1, -1};
     const char* wanted[3] = {"R", "G", "B"};
@@ -479,16 +492,32 @@ image_rgb32f read_exr_memory(std::span<const unsigned char> bytes, const std::st
     return img;
 }
 
+namespace {
+/// The name of a common 8-bit image format recognised by its signature, or nullptr.
+const char* ldr_format_name(std::span<const unsigned char> b) {
+    auto sig = [&](std::initializer_list<unsigned char> m) {
+        return b.size() >= m.size() && std::equal(m.begin(), m.end(), b.begin());
+    };
+    if (sig({0x89, 'P', 'N', 'G', 0x0D, 0x0A, 0x1A, 0x0A})) return "PNG";
+    if (sig({0xFF, 0xD8, 0xFF})) return "JPEG";
+    if (sig({'G', 'I', 'F', '8'})) return "GIF";
+    if (sig({'B', 'M'})) return "BMP";
+    if (sig({'8', 'B', 'P', 'S'})) return "PSD";
+    if (sig({'I', 'I', 0x2A, 0x00}) || sig({'M', 'M', 0x00, 0x2A})) return "TIFF";
+    if (sig({'R', 'I', 'F', 'F'}) && b.size() >= 12 && std::equal(b.begin() + 8, b.begin() + 12, "WEBP")) return "WebP";
+    if (b.size() >= 2 && b[0] == 'P' && b[1] >= '1' && b[1] <= '6') return "PNM";
+    return nullptr;
+}
+} // namespace
+
 image_rgb32f read_image_memory(std::span<const unsigned char> bytes, const std::string& name, const read_options& o,
                                read_report* report) {
     if (bytes.empty()) throw image_error(name, "empty file");
     if (bytes.size() >= 4 && std::memcmp(bytes.data(), exr_magic, 4) == 0) return read_exr_memory(bytes, name, o, report);
     if (starts_with(bytes, hdr_magic1) || starts_with(bytes, hdr_magic2)) return read_hdr_memory(bytes, name, o, report);
-    const int len = int(std::min<std::size_t>(bytes.size(), INT_MAX));
-    int w = 0, h = 0, comp = 0;
-    if (stbi_info_from_memory(bytes.data(), len, &w, &h, &comp))
-        throw image_error(name, "LDR input not supported (an 8-bit image of " + std::to_string(w) + " x " +
-                                    std::to_string(h) + "; give a Radiance .hdr or an OpenEXR file)");
+    if (const char* ldr = ldr_format_name(bytes))
+        throw image_error(name, std::string("LDR input not supported (a ") + ldr +
+                                    " file; give a Radiance .hdr or an OpenEXR file)");
     if (bytes.size() < 4) throw image_error(name, "truncated or unrecognised image (" + std::to_string(bytes.size()) + " bytes)");
     throw image_error(name, "unrecognised image format (neither Radiance HDR nor OpenEXR)");
 }
