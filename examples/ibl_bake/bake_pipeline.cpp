@@ -10,6 +10,7 @@
 // own loops compute each item independently), so the outputs do not depend on --threads.
 
 #include "bake_pipeline.hpp"
+#include "check_texels.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -196,28 +197,6 @@ struct level_check {
     ibl::error_metrics m;
     double ref_ms = 0.0;
 };
-
-struct texel_id {
-    int face, x, y;
-    bool operator==(const texel_id&) const = default;
-};
-
-/// The checked texels of a face size: a g x g grid per face plus the 3 x 3 block around `light`.
-std::vector<texel_id> check_texels(int n, int grid, const dvec3& light) {
-    std::vector<texel_id> t;
-    const int g = std::min(grid, n);
-    for (int f = 0; f < 6; ++f)
-        for (int j = 0; j < g; ++j)
-            for (int i = 0; i < g; ++i) t.push_back({f, int((i + 0.5) * n / g), int((j + 0.5) * n / g)});
-    const ibl::cube_coord<double> c = ibl::cube_lookup(light);
-    const int cx = std::min(int(c.s * n), n - 1), cy = std::min(int(c.t * n), n - 1);
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-            const texel_id id{c.face, std::clamp(cx + dx, 0, n - 1), std::clamp(cy + dy, 0, n - 1)};
-            if (std::find(t.begin(), t.end(), id) == t.end()) t.push_back(id);
-        }
-    return t;
-}
 
 // ---- split sum ---------------------------------------------------------------------------------
 
@@ -465,15 +444,15 @@ void run_bake(const bake_options& opt, std::FILE* out) {
         lc.size = chain.size(l);
         lc.roughness = po.policy.roughness(double(l), chain_levels);
         lc.samples = l == 0 ? 0u : ibl::prefilter_samples(po, l, chain_levels);
-        const std::vector<texel_id> texels = check_texels(lc.size, qs.ref_grid, light);
+        const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qs.ref_grid, light);
         std::vector<dvec3> ref(texels.size());
         with_env(src, [&](const auto& env) {
             ex(texels.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i) {
-                    const texel_id& t = texels[i];
-                    const dvec3 d = ibl::cube_texel_direction<double>(t.face, t.x, t.y, lc.size);
+                    const auto& t = texels[i];
+                    const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size);
                     if (l == 0) {
-                        ref[i] = texel_mean(env, t.face, t.x, t.y, lc.size, level0_ref_k);
+                        ref[i] = texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
                     } else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>) {
                         ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qs.sky_ref_samples, qs.sun_cap_nodes);
                     } else {
@@ -486,7 +465,7 @@ void run_bake(const bake_options& opt, std::FILE* out) {
         // Relative errors use a floor of 1e-3 x the mean radiance (dark texels do not dominate).
         ibl::error_accumulator acc(1e-3 * mean_radiance);
         for (std::size_t i = 0; i < texels.size(); ++i)
-            acc.add(dvec3(chain.texel(texels[i].face, texels[i].x, texels[i].y, l)), ref[i]);
+            acc.add(dvec3(chain.texel(texels[i][0], texels[i][1], texels[i][2], l)), ref[i]);
         lc.m = acc.finish();
         lc.texels = texels.size();
         lc.ref_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();

@@ -18,6 +18,7 @@
 //   ibl::reference_radiance (the split-sum approximation's own error, which no plan can change).
 
 #include "bake_scene.hpp"
+#include "check_texels.hpp"
 
 #include <algorithm>
 #include <array>
@@ -612,15 +613,8 @@ void run_scene_bake(const bake_options& opt, std::FILE* out) {
             lc.expected = lp.expected_error, lc.samples = lp.samples, lc.trilinear = lp.trilinear;
             for (int which = 0; which < 2; ++which) {
                 const ibl::cubemap<float>& c = which == 0 ? chain : fchain;
-                const int lvl = which == 0 ? int(k) : lp.level, n = c.size(lvl), g = std::min(6, n);
-                std::vector<std::array<int, 3>> tex;
-                for (int f = 0; f < 6; ++f)
-                    for (int j = 0; j < g; ++j)
-                        for (int i = 0; i < g; ++i) tex.push_back({f, int((i + 0.5) * n / g), int((j + 0.5) * n / g)});
-                const ibl::cube_coord<double> cc = ibl::cube_lookup(light);
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx)
-                        tex.push_back({cc.face, std::clamp(int(cc.s * n) + dx, 0, n - 1), std::clamp(int(cc.t * n) + dy, 0, n - 1)});
+                const int lvl = which == 0 ? int(k) : lp.level, n = c.size(lvl);
+                const std::vector<std::array<int, 3>> tex = check_texels(n, 6, light);
                 std::vector<dvec3> ref(tex.size());
                 ex(tex.size(), [&](std::size_t b, std::size_t e) {
                     for (std::size_t i = b; i < e; ++i) {

@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "check_texels.hpp"
+
 #include <ibl/brdf/model.hpp>
 #include <ibl/core/color.hpp>
 #include <ibl/core/executor.hpp>
@@ -137,20 +139,6 @@ void measure_sh() {
     }
 }
 
-/// The texels the per-level check of `ibl-bake --scene --compare-full` reads: a 6 x 6 grid per
-/// face plus the 3 x 3 block at the direction `light` (the sun).
-std::vector<std::array<int, 3>> check_texels(int n, const dvec3& light) {
-    std::vector<std::array<int, 3>> tex;
-    const int g = std::min(6, n);
-    for (int f = 0; f < 6; ++f)
-        for (int j = 0; j < g; ++j)
-            for (int i = 0; i < g; ++i) tex.push_back({f, int((i + 0.5) * n / g), int((j + 0.5) * n / g)});
-    const ibl::cube_coord<double> cc = ibl::cube_lookup(light);
-    for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx)
-            tex.push_back({cc.face, std::clamp(int(cc.s * n) + dx, 0, n - 1), std::clamp(int(cc.t * n) + dy, 0, n - 1)});
-    return tex;
-}
 
 double nrmse_at(const std::vector<dvec3>& a, const std::vector<dvec3>& ref) {
     ibl::error_accumulator acc(1e-3);
@@ -186,7 +174,7 @@ void measure_prefilter() {
         for (int v = 1; v < levels; ++v) {
             const double r = policy.roughness(double(v), levels);
             const int n = base >> v;
-            const auto tex = check_texels(n, light);
+            const auto tex = ibl_bake::check_texels(n, 6, light);
             std::vector<dvec3> ref(tex.size());
             ex(tex.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i)
