@@ -84,32 +84,11 @@ struct source_env {
     int width = 0, height = 0;
 };
 
-dvec3 radiance_at(const ibl::sky_environment<double>& e, const dvec3& d) { return e.radiance(d, 0.0); }
-dvec3 radiance_at(const ibl::latlong<float>& e, const dvec3& d) { return dvec3(e.radiance(fvec3(d), 0.0f)); }
-
 template <class F> auto with_env(const source_env& s, F&& f) {
     if (s.analytic) return f(s.sky);
     return f(*s.map);
 }
 
-/// Texel mean of env over texel (x, y) of face f of an n x n face with k x k sub-samples weighted
-/// by the face's solid-angle density (the rule of ibl::bake_cubemap), in double.
-template <class Env> dvec3 texel_mean(const Env& env, int face, int x, int y, int n, int k) {
-    dvec3 acc(0.0);
-    double wsum = 0.0;
-    const double inv = 1.0 / (double(n) * double(k));
-    for (int j = 0; j < k; ++j) {
-        const double tc = 2.0 * (double(y * k + j) + 0.5) * inv - 1.0;
-        for (int i = 0; i < k; ++i) {
-            const double sc = 2.0 * (double(x * k + i) + 0.5) * inv - 1.0;
-            const double r2 = 1.0 + sc * sc + tc * tc;
-            const double w = 1.0 / (r2 * std::sqrt(r2));
-            acc += w * radiance_at(env, ibl::cube_face_point(face, sc, tc) / std::sqrt(r2));
-            wsum += w;
-        }
-    }
-    return acc / wsum;
-}
 
 double lum(const dvec3& c) { return ibl::luminance(c); }
 double min3(const dvec3& v) { return std::min({v.x, v.y, v.z}); }
@@ -452,7 +431,7 @@ void run_bake(const bake_options& opt, std::FILE* out) {
                     const auto& t = texels[i];
                     const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size);
                     if (l == 0) {
-                        ref[i] = texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
+                        ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
                     } else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>) {
                         ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qs.sky_ref_samples, qs.sun_cap_nodes);
                     } else {

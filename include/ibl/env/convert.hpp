@@ -28,6 +28,33 @@
 
 namespace ibl {
 
+/// Mean radiance over texel (x, y) of face `face` of an n x n cube: k x k sub-samples on a regular
+/// grid in (sc, tc), weighted by the face's solid-angle density (1 + sc^2 + tc^2)^(-3/2), the
+/// environment evaluated at `lod` in its own scalar type (environment_scalar_t), sums in double.
+/// Accumulated as ref + sum w (L - ref) / sum w with ref the first sub-sample, so a constant
+/// environment comes back bit for bit.
+template <class Env>
+vec3<double> cube_texel_mean(const Env& env, int face, int x, int y, int n, int k, double lod = 0.0) {
+    using Te = environment_scalar_t<Env>;
+    const double inv_nk = 1.0 / (double(n) * double(k));
+    vec3<double> ref(0.0), acc(0.0);
+    double wsum = 0.0;
+    for (int j = 0; j < k; ++j) {
+        const double tc = 2.0 * (double(y * k + j) + 0.5) * inv_nk - 1.0;
+        for (int i = 0; i < k; ++i) {
+            const double sc = 2.0 * (double(x * k + i) + 0.5) * inv_nk - 1.0;
+            const double r2 = 1.0 + sc * sc + tc * tc;
+            const double w = 1.0 / (r2 * std::sqrt(r2));
+            const vec3<double> d = cube_face_point(face, sc, tc) / std::sqrt(r2);
+            const vec3<double> l(vec3<Te>(env.radiance(vec3<Te>(d), Te(lod))));
+            if (i == 0 && j == 0) ref = l;
+            acc += w * (l - ref);
+            wsum += w;
+        }
+    }
+    return ref + acc / wsum;
+}
+
 /// Bakes `env` (evaluated at `lod`) into a cubemap of face size n with `levels` mip levels
 /// (0 = full chain) using k x k sub-samples per level-0 texel. Throws std::invalid_argument for
 /// n < 1, k < 1 or a bad level count.
@@ -39,27 +66,11 @@ cubemap<T> bake_cubemap(const Env& env, int n, int k, Executor&& ex = Executor{}
     cubemap<T> cube(n, levels); // validates n and levels
     // Rows are written to a scratch buffer (not to the cubemap) so workers share no state.
     std::vector<vec3<T>> base(std::size_t(6) * std::size_t(n) * std::size_t(n));
-    const double inv_nk = 1.0 / (double(n) * double(k));
     ex(std::size_t(6 * n), [&](std::size_t row_begin, std::size_t row_end) {
         for (std::size_t row = row_begin; row < row_end; ++row) {
             const int face = int(row) / n, y = int(row) % n;
             for (int x = 0; x < n; ++x) {
-                vec3<double> ref(0.0), acc(0.0);
-                double wsum = 0.0;
-                for (int j = 0; j < k; ++j) {
-                    const double tc = 2.0 * (double(y * k + j) + 0.5) * inv_nk - 1.0;
-                    for (int i = 0; i < k; ++i) {
-                        const double sc = 2.0 * (double(x * k + i) + 0.5) * inv_nk - 1.0;
-                        const double r2 = 1.0 + sc * sc + tc * tc;
-                        const double w = 1.0 / (r2 * std::sqrt(r2));
-                        const vec3<double> d = cube_face_point(face, sc, tc) / std::sqrt(r2);
-                        const vec3<double> l(vec3<T>(env.radiance(vec3<T>(d), lod)));
-                        if (i == 0 && j == 0) ref = l;
-                        acc += w * (l - ref);
-                        wsum += w;
-                    }
-                }
-                base[row * std::size_t(n) + std::size_t(x)] = vec3<T>(ref + acc / wsum);
+                base[row * std::size_t(n) + std::size_t(x)] = vec3<T>(cube_texel_mean(env, face, x, y, n, k, double(lod)));
             }
         }
     });
