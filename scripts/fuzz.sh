@@ -1,15 +1,15 @@
 #!/usr/bin/env bash
 # scripts/fuzz.sh [RUNS] — build the libFuzzer harness of the ibl-bake image readers
-# (examples/ibl_bake/fuzz) with clang++ -fsanitize=fuzzer,address,undefined and run it for RUNS
+# (tools/ibl-bake/fuzz) with clang++ -fsanitize=fuzzer,address,undefined and run it for RUNS
 # executions (default 100000), one job, on a seed corpus made from the real test EXRs and small
 # valid HDR/EXR/KTX2/PNG files. Not part of the default test run. Crash reproducers land in
-# build/fuzz/artifacts/; copy them to examples/ibl_bake/tests/data/fuzz-<name> as regression
+# build/fuzz/artifacts/; copy them to tools/ibl-bake/tests/data/fuzz-<name> as regression
 # inputs once fixed. tinyexr is compiled from Debian's header (IBL_BAKE_TINYEXR_IMPLEMENTATION,
 # zlib) so that its code is instrumented too.
 set -euo pipefail
 RUNS=${1:-100000}
 ROOT=$(cd "$(dirname "$0")/.." && pwd)
-SRC=$ROOT/examples/ibl_bake
+SRC=$ROOT/tools/ibl-bake
 OUT=$ROOT/build/fuzz
 CXX=${CXX_FUZZ:-clang++}
 mkdir -p "$OUT/corpus" "$OUT/artifacts" "$OUT/seeds"

@@ -8,4 +8,4 @@ cd "$(dirname "$0")/.."
 bash scripts/deps.sh
 cmake --preset release >/dev/null
 cmake --build --preset release --target ibl_bake
-./build/release/examples/ibl_bake/ibl-bake --out build/bake
+./build/release/tools/ibl-bake/ibl-bake --out build/bake

@@ -1,4 +1,4 @@
-// examples/ibl_bake/bake_pipeline.cpp — the ibl-bake pipeline (see docs/ibl-bake.md).
+// tools/ibl-bake/bake_pipeline.cpp — the ibl-bake pipeline (see docs/ibl-bake.md).
 //
 //   source (lat-long file or built-in sky) --k x k supersampled bake--> source cube (n, full mips)
 //   source cube --filtered importance sampling--> prefiltered chain (levels, linear roughness policy)

@@ -1,4 +1,4 @@
-// examples/ibl_bake/main.cpp — ibl-bake: bakes image-based-lighting products from a lat-long HDR
+// tools/ibl-bake/main.cpp — ibl-bake: bakes image-based-lighting products from a lat-long HDR
 // image (Radiance .hdr, OpenEXR) or the built-in sky + sun, with a preview and an error/time
 // report. Usage and file formats: docs/ibl-bake.md, `ibl-bake --help`.
 //

@@ -1,4 +1,4 @@
-// examples/ibl_bake/fuzz/make_seeds.cpp — writes small valid inputs for the fuzz seed corpus:
+// tools/ibl-bake/fuzz/make_seeds.cpp — writes small valid inputs for the fuzz seed corpus:
 // OpenEXR (ZIP, float32), Radiance HDR (run-length and flat scanlines), KTX2 cubemaps.
 #include <cmath>
 #include <cstdio>

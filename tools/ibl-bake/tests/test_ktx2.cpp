@@ -1,4 +1,4 @@
-// examples/ibl_bake/tests/test_ktx2.cpp — the KTX2 cubemap writer, checked by parsing the bytes
+// tools/ibl-bake/tests/test_ktx2.cpp — the KTX2 cubemap writer, checked by parsing the bytes
 // back: header fields, level index (sizes, order, alignment), DFD, key/value data, face order
 // and a texel read at an offset computed independently of the writer; half-float conversion.
 

@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/bake_options.hpp — the command line of ibl-bake and the quality presets.
+// tools/ibl-bake/bake_options.hpp — the command line of ibl-bake and the quality presets.
 //
 // Every option is checked before anything is computed or written: a bad option throws
 // usage_error (main prints "ibl-bake: <message>" and the hint to --help, exit status 2).

@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/json.hpp — a small streaming JSON writer (RFC 8259) for sh.json and
+// tools/ibl-bake/json.hpp — a small streaming JSON writer (RFC 8259) for sh.json and
 // report.json; no dependency.
 //
 //   json_writer j;

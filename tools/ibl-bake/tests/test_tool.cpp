@@ -1,4 +1,4 @@
-// examples/ibl_bake/tests/test_tool.cpp — end-to-end tests of the ibl-bake executable: a full run
+// tools/ibl-bake/tests/test_tool.cpp — end-to-end tests of the ibl-bake executable: a full run
 // produces every file with the right sizes and parseable JSON; output is bit-identical across
 // thread counts; bad options and bad inputs exit non-zero with a message and leave DIR untouched.
 // The executable's path comes from the IBL_BAKE_TOOL definition (CMake: $<TARGET_FILE:ibl_bake>).

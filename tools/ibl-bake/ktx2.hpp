@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/ktx2.hpp — KTX 2.0 cubemap writer (and a validating reader for tests and
+// tools/ibl-bake/ktx2.hpp — KTX 2.0 cubemap writer (and a validating reader for tests and
 // verification) for a mip chain of 6 faces of linear RGB float data.
 //
 // Why KTX2: a published, complete specification (Khronos KTX File Format 2.0), cubemap face order

@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/bake_pipeline.hpp — the ibl-bake pipeline: source -> products -> checks ->
+// tools/ibl-bake/bake_pipeline.hpp — the ibl-bake pipeline: source -> products -> checks ->
 // files (docs/ibl-bake.md describes every product, file and report field).
 
 #include <cstdio>

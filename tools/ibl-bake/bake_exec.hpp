@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/bake_exec.hpp — the tool's executor (work sharing with progress) and the
+// tools/ibl-bake/bake_exec.hpp — the tool's executor (work sharing with progress) and the
 // progress display.
 //
 // progress: one "step" at a time (begin/end, called on the main thread). On a TTY stderr a bar

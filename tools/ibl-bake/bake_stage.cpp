@@ -1,4 +1,4 @@
-// examples/ibl_bake/bake_stage.cpp — staging directory and commit (see bake_stage.hpp).
+// tools/ibl-bake/bake_stage.cpp — staging directory and commit (see bake_stage.hpp).
 
 #include "bake_stage.hpp"
 

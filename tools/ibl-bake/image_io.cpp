@@ -1,4 +1,4 @@
-// examples/ibl_bake/image_io.cpp — the one translation unit with the third-party implementations
+// tools/ibl-bake/image_io.cpp — the one translation unit with the third-party implementations
 // (stb_image, stb_image_write) and the readers/writers of image_io.hpp.
 //
 // Third-party code, all from Debian packages:
@@ -41,7 +41,7 @@
 // Only stb's Radiance HDR decoder is compiled in. LDR inputs are recognised by their signature
 // (ldr_format_name below), never parsed: fuzzing (scripts/fuzz.sh) found undefined behaviour in
 // stb's PNM header parser (signed overflow) and JPEG Huffman-table builder (out-of-bounds write)
-// when they only probed arbitrary bytes; regression inputs in examples/ibl_bake/tests/data/fuzz-*.
+// when they only probed arbitrary bytes; regression inputs in tools/ibl-bake/tests/data/fuzz-*.
 #define STBI_ONLY_HDR
 #include <stb_image.h>
 
@@ -433,7 +433,7 @@ image_rgb32f read_exr_memory(std::span<const unsigned char> bytes, const std::st
                      "OpenEXR");
     // tinyexr sizes its offset table from the optional chunkCount attribute before checking it
     // (a 3 KB file asked for 6.6 GB; found by scripts/fuzz.sh, regression input
-    // examples/ibl_bake/tests/data/fuzz-oom-exr-chunkcount). A scanline image has at most one
+    // tools/ibl-bake/tests/data/fuzz-oom-exr-chunkcount). A scanline image has at most one
     // chunk per row.
     if (H.chunk_count < 0 || H.chunk_count > dh)
         throw image_error(name, "corrupt OpenEXR header (chunkCount " + std::to_string(H.chunk_count) + " for " +

@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/image_io.hpp — image input/output of the ibl-bake tool (host only).
+// tools/ibl-bake/image_io.hpp — image input/output of the ibl-bake tool (host only).
 //
 // Reading: Radiance .hdr (RGBE, decoded by stb_image) and OpenEXR (scanline, single part,
 // decoded by tinyexr) into image_rgb32f: linear RGB, float32, interleaved, top row first.

@@ -1,4 +1,4 @@
-// examples/ibl_bake/tests/test_json.cpp — the JSON writer: structure, number round trip,
+// tools/ibl-bake/tests/test_json.cpp — the JSON writer: structure, number round trip,
 // null for non-finite numbers, string escaping and UTF-8 repair, misuse.
 
 #include <doctest/doctest.h>

@@ -1,4 +1,4 @@
-// examples/ibl_bake/bake_options.cpp — command line parsing of ibl-bake (see bake_options.hpp).
+// tools/ibl-bake/bake_options.cpp — command line parsing of ibl-bake (see bake_options.hpp).
 
 #include "bake_options.hpp"
 

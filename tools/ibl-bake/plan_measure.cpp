@@ -1,4 +1,4 @@
-// examples/ibl_bake/plan_measure.cpp — the measurements behind the decision tables of
+// tools/ibl-bake/plan_measure.cpp — the measurements behind the decision tables of
 // include/ibl/plan.hpp (issue 7). Run it after changing an integrator and update the tables.
 //
 //   1. DFG LUT: the largest bilinear-interpolation error of an exact N^2 table (clamp-to-edge, as

@@ -1,4 +1,4 @@
-// examples/ibl_bake/tests/test_image_io.cpp — image I/O of the bake tool: round trips, the texel
+// tools/ibl-bake/tests/test_image_io.cpp — image I/O of the bake tool: round trips, the texel
 // policy, malformed inputs (each must throw image_error naming the file and the problem), atomic
 // writes, and the shared real data.
 
@@ -269,7 +269,7 @@ TEST_CASE("image_io: malformed inputs throw image_error naming the file and the 
         CHECK(contains(msg, "square.exr"));
     }
     SUBCASE("regression inputs found by fuzzing") {
-        // Every file in examples/ibl_bake/tests/data/fuzz-*: must throw image_error (or decode),
+        // Every file in tools/ibl-bake/tests/data/fuzz-*: must throw image_error (or decode),
         // never crash, hang or leak (the sanitizer build checks the latter).
         for (const auto& entry : fs::directory_iterator(regression_dir)) {
             if (!entry.path().filename().string().starts_with("fuzz-")) continue;

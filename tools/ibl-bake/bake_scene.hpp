@@ -1,5 +1,5 @@
 #pragma once
-// examples/ibl_bake/bake_scene.hpp — `ibl-bake --scene scene.json` (issue 7): parse a scene
+// tools/ibl-bake/bake_scene.hpp — `ibl-bake --scene scene.json` (issue 7): parse a scene
 // description (docs/scene-format.md), plan its products with ibl::make_bake_plan
 // (include/ibl/plan.hpp) and bake exactly the plan; the report says what was left out and the
 // time saved (estimated from the plan's cost model; measured with --compare-full, which also

@@ -1,4 +1,4 @@
-// examples/ibl_bake/bake_scene.cpp — `ibl-bake --scene` (see bake_scene.hpp, docs/scene-format.md).
+// tools/ibl-bake/bake_scene.cpp — `ibl-bake --scene` (see bake_scene.hpp, docs/scene-format.md).
 //
 //   scene.json --parse--> ibl::scene_description --ibl::make_bake_plan--> ibl::bake_plan
 //   source (lat-long file or built-in sky) --bake at plan.source_size--> source cube
@@ -75,7 +75,7 @@ using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 using model = ibl::ggx_height_correlated;
 
-// ---- JSON access (the reader is examples/common/json_value.hpp, shared with bench_plot) ----------
+// ---- JSON access (the reader is json_value.hpp) ----------
 
 using ibl_examples::json_value;
 using jarray = std::vector<json_value>;

@@ -1,4 +1,4 @@
-// examples/ibl_bake/fuzz/fuzz_image_readers.cpp — libFuzzer harness over the memory readers of
+// tools/ibl-bake/fuzz/fuzz_image_readers.cpp — libFuzzer harness over the memory readers of
 // the bake tool: format dispatch, Radiance HDR (header parser, structural walk, stb_image),
 // OpenEXR (compression pre-scan, tinyexr header and pixel decoding) and the KTX2 parser.
 // Contract under test: any input either decodes or throws ibl_bake::image_error; anything else

@@ -1,4 +1,4 @@
-// examples/ibl_bake/ktx2.cpp — KTX2 cubemap writer and validating reader (layout: ktx2.hpp).
+// tools/ibl-bake/ktx2.cpp — KTX2 cubemap writer and validating reader (layout: ktx2.hpp).
 
 #include "ktx2.hpp"
 
