@@ -14,7 +14,7 @@
 //   --quality Q         low | default | high (the mapping is quality_settings below)
 //   --ktx2-format F     f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | f32
 //   --quiet             no progress output on stderr
-//   --scene PATH        bake only what the scene needs (bake_scene.hpp, docs/scene-format.md)
+//   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
 //   --help, --version
 // Values may be given as "--size 32" or "--size=32". Numbers must be plain decimal integers.
@@ -47,7 +47,7 @@ struct bake_options {
     bool quiet = false;
     bool help = false;
     bool version = false;
-    std::string scene;         ///< --scene: plan from this scene file (bake_scene.hpp)
+    std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)
 };
 

@@ -1,9 +1,11 @@
 // tools/ibl-bake/main.cpp — ibl-bake: bakes image-based-lighting products from a lat-long HDR
 // image (Radiance .hdr, OpenEXR) or the built-in sky + sun, with a preview and an error/time
-// report. Usage and file formats: docs/ibl-bake.md, `ibl-bake --help`.
+// report; `--scene` bakes only what a scene needs. Usage and file formats: docs/ibl-bake.md,
+// `ibl-bake --help`.
 //
-// Exit status: 0 success; 1 a failure while baking (unreadable / truncated / LDR input, a write
-// error: the output directory is left as it was, see bake_stage.hpp); 2 bad command line.
+// Exit status: 0 success; 1 a failure while baking (unreadable / truncated / LDR input, a bad
+// scene file, a write error: the output directory is left as it was, see output_stage.hpp);
+// 2 bad command line.
 
 #include <cstdio>
 #include <exception>
@@ -11,8 +13,8 @@
 #include <vector>
 
 #include "bake_options.hpp"
-#include "bake_pipeline.hpp"
-#include "bake_scene.hpp"
+#include "pipeline.hpp"
+#include "stages.hpp"
 
 int main(int argc, char** argv) {
     using namespace ibl_bake;
@@ -28,12 +30,11 @@ int main(int argc, char** argv) {
         return 0;
     }
     if (opt.version) {
-        std::puts("ibl-bake 1.0.0");
+        std::printf("ibl-bake %s\n", version_string().c_str());
         return 0;
     }
     try {
-        if (!opt.scene.empty()) run_scene_bake(opt, stdout);
-        else run_bake(opt, stdout);
+        run_bake(opt, stdout);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "ibl-bake: error: %s\n", e.what());
         return 1;

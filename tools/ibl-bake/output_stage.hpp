@@ -1,5 +1,5 @@
 #pragma once
-// tools/ibl-bake/bake_stage.hpp — all-or-nothing output of ibl-bake.
+// tools/ibl-bake/output_stage.hpp — all-or-nothing output of ibl-bake.
 //
 // Every file is first written into a fresh staging directory created next to DIR (same parent,
 // so the same file system): "<parent>/.<name>.ibl-bake-XXXXXX" (mkdtemp). Only when every file

@@ -1,6 +1,6 @@
-// tools/ibl-bake/bake_stage.cpp — staging directory and commit (see bake_stage.hpp).
+// tools/ibl-bake/output_stage.cpp — staging directory and commit (see output_stage.hpp).
 
-#include "bake_stage.hpp"
+#include "output_stage.hpp"
 
 #include <algorithm>
 #include <cerrno>

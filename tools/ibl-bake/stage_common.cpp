@@ -1,0 +1,174 @@
+// tools/ibl-bake/stage_common.cpp — what several stages share (stages.hpp).
+
+#include "stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <span>
+
+#include <ibl/core/color.hpp>
+#include <ibl/env/cube_geometry.hpp>
+#include <ibl/integrate/dfg.hpp>
+#include <ibl/integrate/prefilter.hpp>
+#include <ibl/sh/convolve.hpp>
+#include <ibl/sh/project.hpp>
+
+namespace ibl_bake {
+
+dvec3 diffuse_data::irradiance_over_pi(const dvec3& n) const {
+    if (kind == ibl::diffuse_product::sh) return glm::max(ibl::sh_shader_evaluate(shader_over_pi, n), dvec3(0.0));
+    if (kind == ibl::diffuse_product::irradiance_map) return dvec3(map.radiance(fvec3(n), 0.0f)) / ibl::pi_v<double>;
+    return dvec3(0.0);
+}
+
+ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
+    const double n_dot_v = std::clamp(glm::dot(n, v), 0.0, 1.0);
+    const dvec3 r = 2.0 * glm::dot(n, v) * n - v;
+    ibl::ibl_sample<double> s;
+    if (chain) {
+        const float lod = policy.lod(float(roughness), virtual_levels) - float(first_level);
+        s.ld = dvec3(chain->radiance(fvec3(r), std::max(lod, 0.0f)));
+    }
+    if (lut) {
+        const fvec3 ab = lut->sample(float(n_dot_v), float(roughness));
+        s.dfg = ibl::vec2<double>(ab.x, ab.y);
+    } else {
+        s.dfg = ibl::dfg_exact<bake_model>(n_dot_v, roughness);
+    }
+    if (diffuse) s.irradiance_over_pi = diffuse->irradiance_over_pi(n);
+    return s;
+}
+
+product_view baked_view(const bake_context& ctx) {
+    product_view v;
+    v.chain = ctx.chain ? &*ctx.chain : nullptr;
+    v.policy = ctx.plan.specular.policy;
+    v.virtual_levels = ctx.plan.specular.virtual_levels;
+    v.first_level = ctx.plan.specular.first_level;
+    v.lut = ctx.lut ? &*ctx.lut : nullptr;
+    v.diffuse = &ctx.diffuse;
+    return v;
+}
+
+dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level) {
+    const int n = cube.size(level);
+    double best = -1.0;
+    dvec3 dir(0.0, 1.0, 0.0);
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const double l = ibl::luminance(dvec3(cube.texel(f, x, y, level)));
+                if (l > best) {
+                    best = l;
+                    dir = ibl::cube_texel_direction<double>(f, x, y, n);
+                }
+            }
+    return dir;
+}
+
+int level_at_most(const ibl::cubemap<float>& cube, int max_face) {
+    int level = 0;
+    while (cube.size(level) > max_face && level + 1 < cube.levels()) ++level;
+    return level;
+}
+
+std::vector<dvec3> texel_sum_irradiance(const ibl::cubemap<float>& cube, int level, const std::vector<dvec3>& normals,
+                                        pool_executor& ex) {
+    const int n = cube.size(level);
+    std::vector<dvec3> dir, rad;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                dir.push_back(ibl::cube_texel_direction<double>(f, x, y, n));
+                rad.push_back(dvec3(cube.texel(f, x, y, level)) * ibl::cube_texel_solid_angle<double>(x, y, n));
+            }
+    std::vector<dvec3> e(normals.size());
+    ex(normals.size(), [&](std::size_t b, std::size_t end) {
+        for (std::size_t i = b; i < end; ++i) {
+            dvec3 s(0.0);
+            for (std::size_t t = 0; t < dir.size(); ++t) s += rad[t] * std::max(0.0, glm::dot(normals[i], dir[t]));
+            e[i] = s;
+        }
+    });
+    return e;
+}
+
+image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level) {
+    const int n = cube.size(level);
+    image_rgb32f img(n, n);
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) {
+            const fvec3& v = cube.texel(face, x, y, level);
+            float* t = img.texel(x, y);
+            t[0] = v.x, t[1] = v.y, t[2] = v.z;
+        }
+    return img;
+}
+
+cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& c) {
+    cubemap_rgb32f k = cubemap_rgb32f::zeros(c.size(0), c.levels());
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x) {
+                    const fvec3& v = c.texel(f, x, y, l);
+                    float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+                    t[0] = v.x, t[1] = v.y, t[2] = v.z;
+                }
+    }
+    return k;
+}
+
+void write_text(const std::string& path, const std::string& text) {
+    write_file_atomic(path, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
+}
+
+void json_triples(json_writer& j, const sh3& c, int count) {
+    j.begin_array();
+    for (int k = 0; k < count; ++k) {
+        j.begin_array();
+        for (int ch = 0; ch < 3; ++ch) j.value(c[k][ch]);
+        j.end_array();
+    }
+    j.end_array();
+}
+
+/// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples.
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, pool_executor& ex) {
+    const int stored_base = std::max(1, sp.virtual_base_size >> sp.first_level);
+    ibl::cubemap<float> chain(stored_base, int(sp.levels.size()));
+    for (std::size_t k = 0; k < sp.levels.size(); ++k) {
+        const ibl::specular_level_plan& lp = sp.levels[k];
+        const int n = chain.size(int(k));
+        if (lp.level == 0) { // the mirror level: the source at the output texel centres
+            const int sl = std::clamp(int(std::lround(std::log2(double(src.size(0)) / double(n)))), 0, src.levels() - 1);
+            chain.fill(int(k), [&](int f, int x, int y) {
+                return src.size(sl) == n ? src.texel(f, x, y, sl)
+                                         : src.radiance(ibl::cube_texel_direction<float>(f, x, y, n), float(sl));
+            });
+            continue;
+        }
+        ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
+            src, lp.roughness, lp.samples, ibl::prefilter_method::filtered_importance, 0.5);
+        table.trilinear = lp.trilinear;
+        const std::vector<fvec3> texels = ibl::convolve_faces(src, table, n, ex);
+        chain.fill(int(k), [&](int f, int x, int y) {
+            return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
+        });
+    }
+    chain.update_borders();
+    return chain;
+}
+
+diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex) {
+    diffuse_data d;
+    d.kind = ibl::diffuse_product::sh;
+    d.bands = 3;
+    d.radiance = ibl::project_cube<3>(
+        src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ex);
+    d.shader_over_pi = ibl::sh_shader_coeffs(d.radiance, ibl::sh_shader_output::irradiance_over_pi);
+    return d;
+}
+
+} // namespace ibl_bake

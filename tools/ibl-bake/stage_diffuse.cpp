@@ -1,0 +1,263 @@
+// tools/ibl-bake/stage_diffuse.cpp — the diffuse products.
+//   sh          projection of the source cube onto the plan's SH bands (exact texel solid angles,
+//               ibl::project_cube), Lambert convolution; the full bake applies the weakest Hanning
+//               window that keeps E >= 0 (ibl::sh_auto_window) when the raw irradiance has a
+//               negative minimum; a scene plan keeps the raw projection (its error figures are for
+//               it; the shader clamps E at 0).
+//   irradiance  an irradiance cubemap of the plan's face size (ibl::irradiance_cubemap).
+// Check of both: E at the texel centres of an 8 x 8-per-face cube against the brute-force sum
+// over every texel of the first source level of face <= 128.
+
+#include "stages.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <ibl/env/cube_geometry.hpp>
+#include <ibl/integrate/irradiance.hpp>
+#include <ibl/sh/convolve.hpp>
+#include <ibl/sh/project.hpp>
+#include <ibl/sh/window.hpp>
+
+namespace ibl_bake {
+
+namespace {
+
+constexpr int check_grid = 8;      ///< check normals: texel centres of an 8 x 8-per-face cube
+constexpr int brute_max_face = 128; ///< brute-force irradiance over a source level of face <= this
+
+double min3(const dvec3& v) { return std::min({v.x, v.y, v.z}); }
+
+std::vector<dvec3> check_normals() {
+    std::vector<dvec3> normals;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < check_grid; ++y)
+            for (int x = 0; x < check_grid; ++x) normals.push_back(ibl::cube_texel_direction<double>(f, x, y, check_grid));
+    return normals;
+}
+
+/// Mean and largest relative error of the RGB sum of E against the brute-force reference.
+struct irradiance_check {
+    int level = 0, face = 0;
+    std::size_t normals = 0;
+    double mean_rel = 0.0, max_rel = 0.0, mean_rel_raw = 0.0, max_rel_raw = 0.0, ms = 0.0;
+};
+
+template <class F> void accumulate(irradiance_check& c, const std::vector<dvec3>& normals, const std::vector<dvec3>& ref,
+                                   F&& e_at, double& mean, double& max) {
+    mean = max = 0.0;
+    for (std::size_t i = 0; i < normals.size(); ++i) {
+        const double er = ref[i].x + ref[i].y + ref[i].z;
+        const dvec3 es = e_at(normals[i]);
+        const double rel = std::fabs(es.x + es.y + es.z - er) / er;
+        mean += rel / double(normals.size());
+        max = std::max(max, rel);
+    }
+    c.normals = normals.size();
+}
+
+const char* sh_convention =
+    "Real spherical harmonics, orthonormal over the sphere, without the Condon-Shortley phase, 3 bands "
+    "(9 coefficients, index k = l*l + l + m). Basis on a unit direction (x, y, z) of the world frame: "
+    "Y0 = 0.282095 (1/(2 sqrt(pi))); Y1 = 0.488603 y; Y2 = 0.488603 z; Y3 = 0.488603 x "
+    "(sqrt(3/(4 pi))); Y4 = 1.092548 x y; Y5 = 1.092548 y z (sqrt(15/pi)/2); "
+    "Y6 = 0.315392 (3 z^2 - 1) (sqrt(5/pi)/4); Y7 = 1.092548 x z; Y8 = 0.546274 (x^2 - y^2) (sqrt(15/pi)/4). "
+    "Frame: right-handed, +Y up; lat-long images map direction (x, y, z) to u = 0.5 + atan2(z, x)/(2 pi), "
+    "v = 0.5 + asin(y)/pi, with the top image row at +Y (v = 1); cubemap faces +X, -X, +Y, -Y, +Z, -Z in the "
+    "OpenGL orientation. 'radiance' holds L_k = integral L(w) Y_k(w) dw (linear RGB, after the window if one "
+    "was applied); 'irradiance' holds E_k = A_l L_k with A_0 = pi, A_1 = 2 pi/3, A_2 = pi/4, so that "
+    "E(n) = sum_k E_k Y_k(n) = integral L(w) max(0, n.w) dw; 'irradiance_over_pi_shader' holds c_k = E_k K_k / pi "
+    "for the polynomial form E(n)/pi = sum_k c_k p_k(n) with p = (1, y, z, x, x y, y z, 3 z^2 - 1, x z, x^2 - y^2) "
+    "(multiply by the diffuse albedo for Lambert).";
+
+class sh_stage final : public stage {
+public:
+    const char* key() const override { return "sh"; }
+    stage_kind kind() const override { return stage_kind::product; }
+    const char* category() const override { return "diffuse"; }
+    bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::sh; }
+    double product_ms() const override { return ms_; }
+
+    void run(bake_context& ctx) override {
+        bands_ = ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
+        auto_window_ = !ctx.scene_mode;
+        texels_ = 6 * ctx.source.size(0) * ctx.source.size(0);
+        ctx.prog.begin("sh");
+        if (bands_ == 2) project<2>(ctx);
+        else project<3>(ctx);
+        irr_ = ibl::sh_irradiance(rad_);
+        shader_ = ibl::sh_shader_coeffs(rad_, ibl::sh_shader_output::irradiance_over_pi);
+        ms_ = ctx.prog.end();
+        ctx.diffuse.kind = ibl::diffuse_product::sh;
+        ctx.diffuse.bands = bands_;
+        ctx.diffuse.radiance = rad_;
+        ctx.diffuse.shader_over_pi = shader_;
+        check(ctx);
+    }
+
+    std::vector<table_row> rows() const override {
+        const std::string method = std::to_string(bands_) + "-band projection, " +
+                                   (windowed_ ? fmt("Hanning window W=%.3g", width_) : std::string("no window"));
+        return {{"sh irradiance", method, std::to_string(texels_) + " texels", ms_,
+                 fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel) +
+                     fmt2(", min E %.3g -> %.3g", min3(min_before_), min3(min_after_))}};
+    }
+    std::vector<file_out> files() const override {
+        return {{"sh.json", [this](const std::string& p) { write_text(p, sh_json()); }}};
+    }
+    void report(json_writer& j) const override;
+
+private:
+    template <int B> void project(const bake_context& ctx) {
+        const ibl::cubemap<float>& src = ctx.source;
+        const ibl::sh_coeffs<double, B> raw = ibl::project_cube<B>(
+            src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ctx.ex);
+        ibl::sh_coeffs<double, B> rad = raw;
+        if (auto_window_) {
+            const ibl::sh_auto_window_result<double, B> win = ibl::sh_auto_window(raw);
+            windowed_ = std::isfinite(win.width);
+            width_ = win.width;
+            min_before_ = win.min_before, min_after_ = win.min_after;
+            rad = win.radiance;
+        } else {
+            min_before_ = min_after_ = ibl::sh_min_irradiance(raw, 4096).value;
+        }
+        for (int k = 0; k < B * B; ++k) raw_[k] = raw[k], rad_[k] = rad[k];
+    }
+    void check(bake_context& ctx);
+    std::string sh_json() const;
+
+    int bands_ = 3, texels_ = 0;
+    bool auto_window_ = true, windowed_ = false;
+    double width_ = 0.0, ms_ = 0.0;
+    dvec3 min_before_{0.0}, min_after_{0.0};
+    sh3 raw_{}, rad_{}, irr_{}, shader_{};
+    irradiance_check c_;
+};
+
+void sh_stage::check(bake_context& ctx) {
+    const auto t0 = std::chrono::steady_clock::now();
+    ctx.prog.begin("check sh");
+    c_.level = level_at_most(ctx.source, brute_max_face);
+    c_.face = ctx.source.size(c_.level);
+    const std::vector<dvec3> normals = check_normals();
+    const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
+    accumulate(c_, normals, ref, [&](const dvec3& n) { return ibl::sh_irradiance_at(rad_, n); }, c_.mean_rel, c_.max_rel);
+    accumulate(c_, normals, ref, [&](const dvec3& n) { return ibl::sh_irradiance_at(raw_, n); }, c_.mean_rel_raw, c_.max_rel_raw);
+    ctx.prog.end();
+    c_.ms = ms_since(t0);
+}
+
+std::string sh_stage::sh_json() const {
+    const int count = bands_ * bands_;
+    json_writer j;
+    j.begin_object();
+    j.key("bands").value(bands_);
+    j.key("radiance");
+    json_triples(j, rad_, count);
+    j.key("irradiance");
+    json_triples(j, irr_, count);
+    j.key("irradiance_over_pi_shader");
+    json_triples(j, shader_, count);
+    j.key("convention").value(sh_convention);
+    j.key("window").begin_object();
+    j.key("applied").value(windowed_);
+    j.key("kind").value("hanning");
+    if (windowed_) j.key("width").value(width_);
+    else j.key("width").null();
+    j.key("rule").value(auto_window_ ? "applied (weakest Hanning window keeping E >= 0 everywhere, ibl::sh_auto_window) only when "
+                                       "the unwindowed irradiance has a negative minimum"
+                                     : "never (scene plan: the raw projection; the shader clamps E at 0)");
+    j.key("min_irradiance_before").begin_array().value(min_before_.x).value(min_before_.y).value(min_before_.z).end_array();
+    j.key("min_irradiance_after").begin_array().value(min_after_.x).value(min_after_.y).value(min_after_.z).end_array();
+    j.end_object();
+    j.end_object();
+    return j.str() + "\n";
+}
+
+void sh_stage::report(json_writer& j) const {
+    j.begin_object();
+    j.key("file").value("sh.json");
+    j.key("method").value(std::to_string(bands_) + "-band projection of the source cube (exact texel solid angles), Lambert convolution");
+    j.key("cost").begin_object().key("bands").value(bands_).key("texels").value(texels_).end_object();
+    j.key("time_ms").value(ms_);
+    j.key("window_applied").value(windowed_);
+    if (windowed_) j.key("window_width").value(width_);
+    else j.key("window_width").null();
+    j.key("min_irradiance_before").value(min3(min_before_));
+    j.key("min_irradiance_after").value(min3(min_after_));
+    j.key("check").begin_object();
+    j.key("reference").value("brute-force cosine integration over every texel of source level " + std::to_string(c_.level) + " (" +
+                             std::to_string(c_.face) + "^2 faces)");
+    j.key("normals").value(c_.normals);
+    j.key("mean_rel").value(c_.mean_rel);
+    j.key("max_rel").value(c_.max_rel);
+    j.key("mean_rel_unwindowed").value(c_.mean_rel_raw);
+    j.key("max_rel_unwindowed").value(c_.max_rel_raw);
+    j.key("time_ms").value(c_.ms);
+    j.end_object();
+    j.end_object();
+}
+
+class irradiance_stage final : public stage {
+public:
+    const char* key() const override { return "irradiance"; }
+    stage_kind kind() const override { return stage_kind::product; }
+    const char* category() const override { return "diffuse"; }
+    bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map; }
+    double product_ms() const override { return ms_; }
+
+    void run(bake_context& ctx) override {
+        opt_.size = ctx.plan.diffuse.map_size;
+        opt_.samples = ctx.plan.diffuse.map_samples;
+        ctx.prog.begin("irradiance map");
+        ctx.diffuse.kind = ibl::diffuse_product::irradiance_map;
+        ctx.diffuse.map = ibl::irradiance_cubemap(ctx.source, opt_, ctx.ex);
+        ms_ = ctx.prog.end();
+        map_ = &ctx.diffuse.map;
+        const auto t0 = std::chrono::steady_clock::now();
+        c_.level = level_at_most(ctx.source, brute_max_face);
+        c_.face = ctx.source.size(c_.level);
+        const std::vector<dvec3> normals = check_normals();
+        const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
+        accumulate(c_, normals, ref, [&](const dvec3& n) { return dvec3(map_->radiance(fvec3(n), 0.0f)); }, c_.mean_rel, c_.max_rel);
+        c_.ms = ms_since(t0);
+    }
+
+    std::vector<table_row> rows() const override {
+        return {{"irradiance map", "cosine importance sampling",
+                 std::to_string(opt_.size) + "^2, " + std::to_string(opt_.samples) + " spp", ms_,
+                 fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel)}};
+    }
+    std::vector<file_out> files() const override {
+        return {{"irradiance.ktx2", [this](const std::string& p) {
+                     write_ktx2_cubemap(p, ktx_cube(*map_), ktx2_format::rgba16f, "ibl-bake " + version_string());
+                 }}};
+    }
+    void report(json_writer& j) const override {
+        j.begin_object();
+        j.key("file").value("irradiance.ktx2");
+        j.key("method").value("irradiance cubemap by cosine importance sampling (ibl::irradiance_cubemap); texels hold E");
+        j.key("cost").begin_object().key("size").value(opt_.size).key("samples").value(opt_.samples).end_object();
+        j.key("time_ms").value(ms_);
+        j.key("check").begin_object();
+        j.key("reference").value("brute-force cosine integration over every texel of source level " + std::to_string(c_.level));
+        j.key("normals").value(c_.normals).key("mean_rel").value(c_.mean_rel).key("max_rel").value(c_.max_rel);
+        j.key("time_ms").value(c_.ms);
+        j.end_object();
+        j.end_object();
+    }
+
+private:
+    ibl::irradiance_options opt_;
+    const ibl::cubemap<float>* map_ = nullptr;
+    double ms_ = 0.0;
+    irradiance_check c_;
+};
+
+} // namespace
+
+std::unique_ptr<stage> make_sh_stage() { return std::make_unique<sh_stage>(); }
+std::unique_ptr<stage> make_irradiance_stage() { return std::make_unique<irradiance_stage>(); }
+
+} // namespace ibl_bake

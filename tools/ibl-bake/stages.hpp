@@ -1,0 +1,96 @@
+#pragma once
+// tools/ibl-bake/stages.hpp — the stages of the bake, in the order the pipeline runs them, and
+// what several of them share (pipeline.hpp describes the stage interface).
+//
+//   plan          the full plan, or the scene's plan (--scene) and what it leaves out
+//   source        read the input (or the built-in sky); k x k supersampled bake to the source cube
+//   specular      the plan's levels of the GGX-prefiltered chain (filtered importance sampling)
+//   sh            SH projection of the source cube (the plan's bands), window, irradiance
+//   irradiance    irradiance cubemap (when the plan chooses a map over SH)
+//   dfg           the split-sum DFG table by exact quadrature
+//   split_sum     check: the baked products through the runtime model against the full integral
+//   preview       check: a sphere grid rendered from the baked products
+//   compare_full  check (--scene --compare-full): full and converged bakes, the plan's error
+
+#include <chrono>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <ibl/brdf/model.hpp>
+#include <ibl/integrate/roughness_mip.hpp>
+#include <ibl/shade.hpp>
+
+#include "ktx2.hpp"
+#include "pipeline.hpp"
+
+namespace ibl_bake {
+
+std::unique_ptr<stage> make_plan_stage();
+std::unique_ptr<stage> make_source_stage();
+std::unique_ptr<stage> make_specular_stage();
+std::unique_ptr<stage> make_sh_stage();
+std::unique_ptr<stage> make_irradiance_stage();
+std::unique_ptr<stage> make_dfg_stage();
+std::unique_ptr<stage> make_split_sum_stage();
+std::unique_ptr<stage> make_preview_stage();
+std::unique_ptr<stage> make_compare_full_stage();
+
+/// The BRDF model of every product and check.
+using bake_model = ibl::ggx_height_correlated;
+
+/// The package version (include/ibl/core/config.hpp), e.g. "0.1.0".
+inline std::string version_string() {
+    return std::to_string(ibl::version_major) + "." + std::to_string(ibl::version_minor) + "." + std::to_string(ibl::version_patch);
+}
+
+inline constexpr const char* face_names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
+
+/// Milliseconds since t0.
+inline double ms_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// The products as a renderer samples them: the chain at lod = policy(r) over the virtual chain
+/// minus the first stored level (clamped at 0), trilinearly; the DFG table bilinearly (or dfg_exact
+/// when there is none); the diffuse product (or `irradiance_over_pi` when given).
+struct product_view {
+    const ibl::cubemap<float>* chain = nullptr;
+    ibl::roughness_mip_policy policy{};
+    int virtual_levels = 1, first_level = 0;
+    const ibl::dfg_lut* lut = nullptr;
+    const diffuse_data* diffuse = nullptr;
+
+    ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
+};
+
+/// The products of ctx as a renderer samples them.
+product_view baked_view(const bake_context& ctx);
+
+/// Direction of the brightest texel of a cube level (luminance; first one on ties).
+dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
+
+/// The first level of `cube` whose face is <= max_face (the last level if none is).
+int level_at_most(const ibl::cubemap<float>& cube, int max_face);
+
+/// Irradiance E(n) at each normal by summing every texel of `level` (cosine-weighted, exact texel
+/// solid angles).
+std::vector<dvec3> texel_sum_irradiance(const ibl::cubemap<float>& cube, int level, const std::vector<dvec3>& normals,
+                                        pool_executor& ex);
+
+/// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
+/// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, pool_executor& ex);
+
+/// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
+diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
+
+/// Files: one face of a cube level as an RGB image; a cube as the KTX2 writer's input; text.
+image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level);
+cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& cube);
+void write_text(const std::string& path, const std::string& text);
+
+/// Writes an array of RGB triples (the first `count` coefficients).
+void json_triples(json_writer& j, const sh3& c, int count);
+
+} // namespace ibl_bake
