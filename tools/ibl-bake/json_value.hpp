@@ -1,4 +1,4 @@
-// json_value.hpp — a small, strict JSON reader shared by the examples (bench_plot, ibl-bake --scene) (RFC 8259: objects, arrays,
+// json_value.hpp — a small, strict JSON reader for ibl-bake --scene (RFC 8259: objects, arrays,
 // strings with every escape including \uXXXX surrogate pairs, numbers, true/false/null), plus the
 // four non-standard number spellings Google Benchmark writes for non-finite counters
 // (NaN, -NaN, Infinity, -Infinity). Errors throw json_error with "line:column: what".
