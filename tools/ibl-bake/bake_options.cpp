@@ -2,7 +2,11 @@
 
 #include "bake_options.hpp"
 
+#include <algorithm>
 #include <charconv>
+#include <functional>
+#include <initializer_list>
+#include <map>
 #include <string_view>
 
 namespace ibl_bake {
@@ -46,76 +50,85 @@ long long parse_integer(const std::string& option, const std::string& text, long
 
 } // namespace
 
-bake_options parse_options(const std::vector<std::string>& args) {
-    bake_options o;
-    bool have_out = false;
-    for (std::size_t i = 0; i < args.size(); ++i) {
-        std::string name = args[i], value;
-        bool inline_value = false;
-        if (name.rfind("--", 0) == 0) {
-            const auto eq = name.find('=');
-            if (eq != std::string::npos) {
-                value = name.substr(eq + 1);
-                name = name.substr(0, eq);
-                inline_value = true;
-            }
-        } else {
-            throw usage_error("unexpected argument '" + name + "' (options start with --)");
-        }
-        auto flag = [&] {
-            if (inline_value) throw usage_error(name + " takes no value");
-        };
-        auto take = [&]() -> std::string {
-            if (inline_value) return value;
-            if (i + 1 >= args.size()) throw usage_error(name + ": missing value");
-            return args[++i];
-        };
-        if (name == "--help" || name == "-h") {
-            flag();
-            o.help = true;
-        } else if (name == "--version") {
-            flag();
-            o.version = true;
-        } else if (name == "--quiet") {
-            flag();
-            o.quiet = true;
-        } else if (name == "--scene") {
-            o.scene = take();
-            if (o.scene.empty()) throw usage_error("--scene: empty path");
-        } else if (name == "--compare-full") {
-            flag();
-            o.compare_full = true;
-        } else if (name == "--input") {
-            o.input = take();
-            if (o.input.empty()) throw usage_error("--input: empty path");
-        } else if (name == "--out") {
-            o.out = take();
-            if (o.out.empty()) throw usage_error("--out: empty path");
-            have_out = true;
-        } else if (name == "--size") {
-            o.size = int(parse_integer(name, take(), 1, 4096));
-        } else if (name == "--lut-size") {
-            o.lut_size = int(parse_integer(name, take(), 1, 1024));
-        } else if (name == "--levels") {
-            o.levels = int(parse_integer(name, take(), 0, 13));
-        } else if (name == "--threads") {
-            o.threads = unsigned(parse_integer(name, take(), 0, 256));
-        } else if (name == "--quality") {
-            const std::string q = take();
-            if (q == "low") o.q = quality::low;
-            else if (q == "default") o.q = quality::standard;
-            else if (q == "high") o.q = quality::high;
-            else throw usage_error("--quality: expected low, default or high, got '" + q + "'");
-        } else if (name == "--ktx2-format") {
-            const std::string f = take();
-            if (f == "f16") o.ktx2_f32 = false;
-            else if (f == "f32") o.ktx2_f32 = true;
-            else throw usage_error("--ktx2-format: expected f16 or f32, got '" + f + "'");
-        } else {
-            throw usage_error("unknown option '" + name + "'");
-        }
+namespace {
+
+/// One value from a fixed list, or a usage_error naming the choices.
+std::string choice(const std::string& option, const std::string& v, std::initializer_list<const char*> allowed) {
+    std::string list;
+    for (const char* a : allowed) {
+        if (v == a) return v;
+        list += (list.empty() ? "" : ", ") + std::string(a);
     }
-    if (o.help || o.version) return o;
+    throw usage_error(option + ": expected one of " + list + ", got '" + v + "'");
+}
+
+/// A comma-separated list of values from a fixed list (each once).
+std::vector<std::string> choices(const std::string& option, const std::string& v, std::initializer_list<const char*> allowed) {
+    std::vector<std::string> out;
+    std::size_t b = 0;
+    while (b <= v.size()) {
+        const std::size_t e = std::min(v.find(',', b), v.size());
+        const std::string item = choice(option, v.substr(b, e - b), allowed);
+        if (std::find(out.begin(), out.end(), item) != out.end()) throw usage_error(option + ": '" + item + "' given twice");
+        out.push_back(item);
+        b = e + 1;
+    }
+    return out;
+}
+
+std::string path_value(const std::string& option, const std::string& v) {
+    if (v.empty()) throw usage_error(option + ": empty path");
+    return v;
+}
+
+using handler = std::function<void(bake_options&, const std::string&)>;
+struct option_spec {
+    bool takes_value;
+    handler apply;
+};
+
+const std::map<std::string, option_spec>& option_table() {
+    static const std::map<std::string, option_spec> t = {
+        {"--help", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
+        {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
+        {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
+        {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
+        {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
+        {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
+        {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
+        {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
+        {"--part", {true, [](bake_options& o, const std::string& v) {
+             if (v.empty()) throw usage_error("--part: empty name");
+             o.part = v;
+         }}},
+        {"--input-layout", {true, [](bake_options& o, const std::string& v) {
+             o.input_layout = choice("--input-layout", v, {"auto", "latlong", "hcross", "vcross", "faces", "ktx2"});
+         }}},
+        {"--layout", {true, [](bake_options& o, const std::string& v) {
+             o.layouts = choices("--layout", v, {"faces", "latlong", "cross", "octahedral"});
+         }}},
+        {"--size", {true, [](bake_options& o, const std::string& v) { o.size = int(parse_integer("--size", v, 1, 4096)); }}},
+        {"--lut-size", {true, [](bake_options& o, const std::string& v) { o.lut_size = int(parse_integer("--lut-size", v, 1, 1024)); }}},
+        {"--levels", {true, [](bake_options& o, const std::string& v) { o.levels = int(parse_integer("--levels", v, 0, 13)); }}},
+        {"--threads", {true, [](bake_options& o, const std::string& v) { o.threads = unsigned(parse_integer("--threads", v, 0, 256)); }}},
+        {"--max-input-pixels", {true, [](bake_options& o, const std::string& v) {
+             o.max_input_pixels = std::uint64_t(parse_integer("--max-input-pixels", v, 1, 1ll << 32));
+         }}},
+        {"--quality", {true, [](bake_options& o, const std::string& v) {
+             const std::string q = choice("--quality", v, {"low", "default", "high"});
+             o.q = q == "low" ? quality::low : q == "high" ? quality::high : quality::standard;
+         }}},
+        {"--ktx2-format", {true, [](bake_options& o, const std::string& v) {
+             const std::string f = choice("--ktx2-format", v, {"f16", "f32", "rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"});
+             o.ktx2_format = f == "f16" ? "rgba16f" : f == "f32" ? "rgba32f" : f;
+             o.ktx2_f32 = o.ktx2_format == "rgba32f";
+         }}},
+    };
+    return t;
+}
+
+/// Checks that need every option: required ones, combinations, --levels against --size.
+void check_combination(const bake_options& o, bool have_out) {
     if (!have_out) throw usage_error("--out DIR is required");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.levels > 0) {
@@ -125,6 +138,35 @@ bake_options parse_options(const std::vector<std::string>& args) {
             throw usage_error("--levels: " + std::to_string(o.levels) + " exceeds the " + std::to_string(full) +
                               " levels of a " + std::to_string(o.size) + " face");
     }
+}
+
+} // namespace
+
+bake_options parse_options(const std::vector<std::string>& args) {
+    bake_options o;
+    bool have_out = false;
+    for (std::size_t i = 0; i < args.size(); ++i) {
+        std::string name = args[i], value;
+        bool inline_value = false;
+        if (name.rfind("--", 0) != 0 && name != "-h")
+            throw usage_error("unexpected argument '" + name + "' (options start with --)");
+        if (const auto eq = name.find('='); eq != std::string::npos) {
+            value = name.substr(eq + 1);
+            name = name.substr(0, eq);
+            inline_value = true;
+        }
+        const auto it = option_table().find(name);
+        if (it == option_table().end()) throw usage_error("unknown option '" + name + "'");
+        if (!it->second.takes_value && inline_value) throw usage_error(name + " takes no value");
+        if (it->second.takes_value && !inline_value) {
+            if (i + 1 >= args.size()) throw usage_error(name + ": missing value");
+            value = args[++i];
+        }
+        it->second.apply(o, value);
+        have_out = have_out || name == "--out";
+    }
+    if (o.help || o.version) return o;
+    check_combination(o, have_out);
     return o;
 }
 
@@ -132,14 +174,19 @@ std::string usage_text() {
     return "usage: ibl-bake --out DIR [options]\n"
            "Bakes image-based-lighting products (prefiltered specular cubemap, SH irradiance, DFG LUT),\n"
            "a preview and an error/time report from a lat-long HDR image or the built-in sky.\n\n"
-           "  --input PATH       lat-long (2:1) Radiance .hdr or OpenEXR (default: built-in sky + sun)\n"
+           "  --input PATH       Radiance .hdr, OpenEXR or KTX2: lat-long (2:1), cross (4:3 or 3:4), or six faces\n"
+           "                     (a path with {face}: px nx py ny pz nz); default: the built-in sky + sun\n"
+           "  --input-layout L   auto (default: from the aspect ratio) | latlong | hcross | vcross | faces | ktx2\n"
+           "  --part NAME        the part of a multi-part EXR (default: the first with R, G, B)\n"
+           "  --max-input-pixels N  refuse larger inputs before decoding (default 134217728 = 16384 x 8192)\n"
            "  --out DIR          output directory (created; existing files of the same names replaced)\n"
            "  --size N           face size of the prefiltered base level, 1..4096 (default 256)\n"
            "  --lut-size N       DFG LUT size, 1..1024 (default 128)\n"
            "  --levels N         prefiltered mip levels, 0 = automatic (default)\n"
            "  --threads N        worker threads, 0 = all cores (default)\n"
            "  --quality Q        low | default | high\n"
-           "  --ktx2-format F    f16 (default) | f32\n"
+           "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
+           "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
            "  --quiet            no progress on stderr\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"

@@ -4,7 +4,13 @@
 // Every option is checked before anything is computed or written: a bad option throws
 // usage_error (main prints "ibl-bake: <message>" and the hint to --help, exit status 2).
 //
-//   --input PATH        lat-long (2:1) Radiance .hdr or OpenEXR; omitted: the built-in sky + sun
+//   --input PATH        Radiance .hdr, OpenEXR or KTX2 cubemap: a lat-long (2:1), a horizontal (4:3) or
+//                       vertical (3:4) cross, or six face files (a path containing {face}); omitted:
+//                       the built-in sky + sun
+//   --input-layout L    auto (from the aspect ratio) | latlong | hcross | vcross | faces | ktx2
+//   --part NAME         the part of a multi-part EXR to read (default: the first with R, G, B)
+//   --max-input-pixels N  inputs with more pixels are refused before decoding (default 2^27)
+//   --layout L[,L...]   files per specular level: faces (default), latlong, cross, octahedral
 //   --out DIR           output directory (required)
 //   --size N            face size of the prefiltered base level, 1..4096 (default 256)
 //   --lut-size N        DFG LUT texels per side, 1..1024 (default 128)
@@ -12,7 +18,8 @@
 //                       to [1, 6] (smallest face >= 4 for N >= 16), at most the full chain
 //   --threads N         worker threads, 0 = all cores (default 0), at most 256
 //   --quality Q         low | default | high (the mapping is quality_settings below)
-//   --ktx2-format F     f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | f32
+//   --ktx2-format F     rgba16f = f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | rgba32f = f32 |
+//                       b10g11r11 (VK_FORMAT_B10G11R11_UFLOAT_PACK32) | e5b9g9r9 (..._E5B9G9R9_UFLOAT_PACK32)
 //   --quiet             no progress output on stderr
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
@@ -43,7 +50,12 @@ struct bake_options {
     int levels = 0;      ///< 0: automatic
     unsigned threads = 0;
     quality q = quality::standard;
-    bool ktx2_f32 = false;
+    bool ktx2_f32 = false;       ///< ktx2_format == "rgba32f"
+    std::string ktx2_format = "rgba16f"; ///< rgba16f | rgba32f | b10g11r11 | e5b9g9r9
+    std::string part;            ///< --part: EXR part name (empty: the first with R, G, B)
+    std::string input_layout = "auto"; ///< auto | latlong | hcross | vcross | faces | ktx2
+    std::vector<std::string> layouts{"faces"}; ///< per-level files: faces, latlong, cross, octahedral
+    std::uint64_t max_input_pixels = std::uint64_t(1) << 27; ///< 16384 x 8192
     bool quiet = false;
     bool help = false;
     bool version = false;
