@@ -11,7 +11,10 @@
 #   ibl/sh.hpp        core/ sh/ env/cube_geometry.hpp   (no integrate/, batch/: no prefilter code)
 #   ibl/shade.hpp     core/ brdf/                       (takes products as values, bakes nothing)
 #   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
+#   ibl/batch.hpp     core/ brdf/ sampling/ env/ batch/ (kernels; never integrate/, which calls them)
+#   ibl/batch/**.hpp  the same, for every header under batch/ (also one the umbrella leaves out)
 #
+# A header field with a '*' is a glob (relative to include/ibl, recursive): each match is checked.
 # usage: cmake -DCXX=<compiler> -DINCLUDE_DIR=<repo>/include -DGLM_INCLUDE=<dirs;...>
 #              -DWORK_DIR=<scratch dir> -P header_deps.cmake
 cmake_minimum_required(VERSION 3.21)
@@ -23,7 +26,9 @@ set(rules
     "env.hpp|core/ env/"
     "sh.hpp|core/ sh/ env/cube_geometry.hpp"
     "shade.hpp|core/ brdf/"
-    "plan.hpp|core/ integrate/roughness_mip.hpp")
+    "plan.hpp|core/ integrate/roughness_mip.hpp"
+    "batch.hpp|core/ brdf/ sampling/ env/ batch/"
+    "batch/*.hpp|core/ brdf/ sampling/ env/ batch/")
 
 file(MAKE_DIRECTORY ${WORK_DIR})
 file(REAL_PATH ${INCLUDE_DIR}/ibl IBL_DIR)
@@ -34,7 +39,26 @@ foreach(d IN LISTS GLM_INCLUDE)
     endif()
 endforeach()
 set(failed 0)
+set(expanded "")
 foreach(rule IN LISTS rules)
+    string(REPLACE "|" ";" parts "${rule}")
+    list(GET parts 0 pattern)
+    list(GET parts 1 allowed)
+    if(pattern MATCHES "\\*")
+        file(GLOB_RECURSE matches RELATIVE ${IBL_DIR} ${IBL_DIR}/${pattern})
+        if(NOT matches)
+            message(SEND_ERROR "${pattern}: no header matches (the check is broken)")
+            set(failed 1)
+        endif()
+        list(SORT matches)
+        foreach(m IN LISTS matches)
+            list(APPEND expanded "${m}|${allowed}")
+        endforeach()
+    else()
+        list(APPEND expanded "${rule}")
+    endif()
+endforeach()
+foreach(rule IN LISTS expanded)
     string(REPLACE "|" ";" parts "${rule}")
     list(GET parts 0 header)
     list(GET parts 1 allowed)

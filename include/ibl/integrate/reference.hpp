@@ -31,10 +31,26 @@
 // * reference_irradiance_sky(sky, n, samples, cap_nodes): E_sky by reference_irradiance on the
 //   sky without its sun plus the sun's cap integral of max(n.l, 0) by the same cap rule (exact
 //   also when the cap straddles n's horizon, unlike sky_environment::sun_irradiance).
+// * irradiance_texel_sum(cube, level, normals, ex): the brute-force sum over every texel t of one
+//   cubemap level, E(n) = sum_t L_t Omega_t max(0, n.d_t), with the exact texel solid angles
+//   Omega_t (cube_texel_solid_angle) and the texel-centre directions d_t (cube_texel_direction),
+//   in double. It is the exact irradiance of the environment that is constant over each texel
+//   *up to the centre rule in each texel*: the cosine is taken at the texel centre, so even a
+//   constant environment is off pi L by O(1 / n^2) (measured: |E - pi L| <= 1.05 L / n^2 for
+//   n >= 8, worst at the face normals; the tests show the 1 / n^2 convergence). Polynomials of
+//   degree <= 2 in d that the cube's symmetries average (e.g. max(0, d_y) max(0, d_y) = d_y^2
+//   on the upper half) come out exact up to rounding. Cost: 6 n^2 multiply-adds per normal (a
+//   dot product, a max, a vec3 multiply-add), plus 6 n^2 directions and n^2 solid angles once;
+//   memory 2 x 6 n^2 vec3<double> (1.2 MB at n = 64). irradiance_texel_sum_level(cube, max_face)
+//   picks the first level whose face is <= max_face (bounding the cost per normal).
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <span>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -47,6 +63,7 @@
 #include "../core/vec.hpp"
 #include "../env/analytic.hpp"
 #include "../env/cube_geometry.hpp"
+#include "../env/cubemap.hpp"
 #include "../env/environment.hpp"
 #include "../sampling/ggx.hpp"
 #include "../sampling/hemisphere.hpp"
@@ -177,6 +194,64 @@ vec3<double> reference_irradiance_sky(const sky_environment<T>& sky, const vec3<
                                                   double(sky.sun_angular_radius), cap_nodes,
                                                   [&](const vec3<double>& l) { return vec3<double>(saturate(glm::dot(nn, l))); });
     return e + vec3<double>(sky.sun_radiance) * cap.x;
+}
+
+/// The first level of c whose face size is <= max_face, or the coarsest level if none is: the level
+/// irradiance_texel_sum runs on for a cost of at most 6 max_face^2 terms per normal (when the
+/// chain reaches that size). Throws std::invalid_argument if max_face < 1.
+template <class T> int irradiance_texel_sum_level(const cubemap<T>& c, int max_face) {
+    if (max_face < 1)
+        throw std::invalid_argument("ibl::irradiance_texel_sum_level: max_face must be >= 1, got " +
+                                    std::to_string(max_face));
+    int level = 0;
+    while (c.size(level) > max_face && level + 1 < c.levels()) ++level;
+    return level;
+}
+
+/// Brute-force irradiance over the texels of level `level` of c (see the header): for each normal
+/// n_i, E_i = sum over faces f = 0..5, rows y, columns x (in that order) of
+///     (vec3<double>(L_t) * Omega_t) * max(0, dot(n_i, d_t)),
+/// accumulated in double in exactly that order (the texel's radiance times its solid angle first,
+/// then times the clamped cosine), so the result is a fixed function of the texels and the normal;
+/// the executor spreads the normals (work items: normals) and never changes a result.
+/// Normals are used as given, not normalised: the sum is homogeneous of degree 1 in n, so a normal
+/// of length s gives s E(n / s) up to rounding (exactly, bit for bit, when s is a power of two),
+/// a zero normal gives 0, and a NaN component makes every clamped cosine max(0, NaN) = 0, so E = 0.
+/// Non-finite radiance components read as 0. Borders are not read (they need not be valid).
+/// Throws std::invalid_argument unless 0 <= level < c.levels().
+template <class T, class Executor = serial_executor>
+std::vector<vec3<double>> irradiance_texel_sum(const cubemap<T>& c, int level, std::span<const vec3<double>> normals,
+                                               Executor&& ex = Executor{}) {
+    if (level < 0 || level >= c.levels())
+        throw std::invalid_argument("ibl::irradiance_texel_sum: level must be in [0, " + std::to_string(c.levels()) +
+                                    "), got " + std::to_string(level));
+    const int n = c.size(level);
+    const std::size_t nn = std::size_t(n) * std::size_t(n);
+    std::vector<double> omega(nn); // the same on every face
+    for (int y = 0; y < n; ++y)
+        for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+    std::vector<vec3<double>> dir, rad;
+    dir.reserve(6 * nn);
+    rad.reserve(6 * nn);
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                vec3<double> L(c.texel(f, x, y, level));
+                for (int k = 0; k < 3; ++k)
+                    if (!is_finite(L[k])) L[k] = 0.0;
+                dir.push_back(cube_texel_direction<double>(f, x, y, n));
+                rad.push_back(L * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)]);
+            }
+    std::vector<vec3<double>> out(normals.size());
+    ex(normals.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const vec3<double> ni = normals[i];
+            vec3<double> s(0.0);
+            for (std::size_t t = 0; t < dir.size(); ++t) s += rad[t] * std::max(0.0, glm::dot(ni, dir[t]));
+            out[i] = s;
+        }
+    });
+    return out;
 }
 
 /// fn(unit direction) at every texel centre of an n x n-per-face cube, in cubemap order

@@ -1,0 +1,215 @@
+#pragma once
+// ibl/batch/sphere_kernel.hpp — the structure-of-arrays kernel of the cubemap spherical convolution
+// (the fast path of integrate/sphere_convolve.hpp, which the prefilter and the irradiance
+// convolution use; host only). The integrator builds the tables; this header runs them over texels.
+//
+//   out[k] = factor * sum_i w_i B(src, level_i, F(dir_k) l_i)
+// B: the bilinear lookup on one level of the packed source, F(dir) = make_frame(dir) the tangent
+// frame of output direction k, l_i the tap directions (tangent space, z = dir), w_i > 0 the tap
+// weights, factor = scale / norm (norm = tap_weight_sum in the kernel's order, or 1).
+//
+//  * packed_cube: the source copied once into a bordered float4 layout (RGB + padding), levels one
+//    after the other; non-finite components are stored as 0.
+//  * tap_table: bilinear taps on single levels (the integrator splits a sample with fractional lod
+//    into taps on floor(lod) and floor(lod) + 1: the trilinear lookup), so the kernel reads exactly
+//    one level per tap and the level's size, strides and offset are loop invariants.
+//  * convolve_lanes<W>: W output texels of one face row. Per tap, lane loop 1 rotates the tap
+//    direction into each texel's frame, selects the face branch-free (lane_cube_coord) and forms
+//    the bilinear address and weights (vectorisable); lane loop 2 reads the 2 x 2 texels and
+//    accumulates. Accumulation is in float in blocks of tap_block taps whose sums are added to the
+//    totals (error ~ (tap_block + taps / tap_block) eps instead of taps * eps); tap_weight_sum is
+//    the normaliser in the same blocked order, so a source of ones returns exactly 1.
+//  * convolve_row: one face row in chunks of convolve_width lanes, the tail at width 1.
+// Determinism: every output texel is a fixed sequence of operations on the taps and the source.
+
+#include <cstddef>
+#include <vector>
+
+#include "../core/config.hpp"
+#include "../core/frame.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
+#include "../env/cube_geometry.hpp"
+#include "../env/cubemap.hpp"
+
+namespace ibl {
+
+namespace detail {
+
+/// Taps per accumulation block of the fast path (see the header comment).
+inline constexpr std::size_t tap_block = 32;
+
+/// A cubemap copied into float4 texels (RGB + padding), every face with its 1-texel border,
+/// levels one after the other. Non-finite components are stored as 0.
+struct packed_cube {
+    struct level {
+        int n = 1;           ///< face size
+        int stride = 3;      ///< n + 2
+        int face_stride = 9; ///< (n + 2)^2 texels
+        int offset = 0;      ///< texel index of (face 0, x = -1, y = -1)
+        float nf = 1.f;      ///< float(n)
+    };
+    std::vector<level> levels;
+    std::vector<float> data; ///< 4 floats per texel
+};
+
+template <class T> packed_cube pack_cube(const cubemap<T>& c) {
+    IBL_ASSERT(c.borders_valid());
+    packed_cube p;
+    std::size_t total = 0;
+    for (int l = 0; l < c.levels(); ++l) {
+        packed_cube::level li;
+        li.n = c.size(l);
+        li.stride = li.n + 2;
+        li.face_stride = li.stride * li.stride;
+        li.offset = int(total);
+        li.nf = float(li.n);
+        total += std::size_t(6) * std::size_t(li.face_stride);
+        p.levels.push_back(li);
+    }
+    p.data.assign(4 * total, 0.f);
+    for (int l = 0; l < c.levels(); ++l) {
+        const packed_cube::level& li = p.levels[std::size_t(l)];
+        for (int f = 0; f < 6; ++f)
+            for (int y = -1; y <= li.n; ++y)
+                for (int x = -1; x <= li.n; ++x) {
+                    const vec3<T>& v = c.texel(f, x, y, l);
+                    float* q = p.data.data() +
+                               4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
+                                    std::size_t(y + 1) * std::size_t(li.stride) + std::size_t(x + 1));
+                    for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
+                }
+    }
+    return p;
+}
+
+/// The fast path's table: bilinear taps on single levels, in tap_block-sized blocks.
+struct tap_table {
+    std::vector<float> x, y, z, w;
+    std::vector<int> level;
+    float factor = 1.f; ///< scale / norm, norm summed in the kernel's blocked order
+};
+
+/// Sum of the tap weights in the kernel's order (block partial sums of tap_block taps added to the
+/// total, as convolve_lanes accumulates), so that factor = scale / tap_weight_sum makes a source of
+/// ones return exactly scale.
+inline float tap_weight_sum(const tap_table& t) noexcept {
+    float total = 0.f;
+    for (std::size_t b = 0; b < t.w.size(); b += tap_block) {
+        float part = 0.f;
+        const std::size_t e = b + tap_block < t.w.size() ? b + tap_block : t.w.size();
+        for (std::size_t i = b; i < e; ++i) part += t.w[i];
+        total += part;
+    }
+    return total;
+}
+
+/// W lanes of output directions (unit) with their tangent frames.
+template <std::size_t W> struct lane_frames {
+    float tx[W], ty[W], tz[W], bx[W], by[W], bz[W], nx[W], ny[W], nz[W];
+};
+
+/// Face selection and face texture coordinates of a (non-zero, finite) direction for the lane
+/// loops: the table of env/cube_geometry.hpp with the tie rule X before Y before Z, as float
+/// selects only (no bool-to-float conversions, no branches), so the loop around it vectorises.
+/// Agrees with cube_lookup on face and (s, t) up to rounding (s = 0.5 sc / ma + 0.5).
+IBL_FUNC_VOID void lane_cube_coord(float dx, float dy, float dz, int& face, float& s, float& t) noexcept {
+    const float ax = dx < 0.f ? -dx : dx, ay = dy < 0.f ? -dy : dy, az = dz < 0.f ? -dz : dz;
+    const bool xm = (ax >= ay) & (ax >= az);
+    const bool ym = (!xm) & (ay >= az);
+    const float ma = xm ? ax : (ym ? ay : az);
+    const float major = xm ? dx : (ym ? dy : dz);
+    const bool neg = major < 0.f;
+    const float sg = neg ? -1.f : 1.f;
+    const float sc = xm ? -sg * dz : (ym ? dx : sg * dx);
+    const float tc = ym ? sg * dz : -dy;
+    face = (xm ? 0 : (ym ? 2 : 4)) + (neg ? 1 : 0);
+    const float half_inv = 0.5f / ma;
+    const float s0 = sc * half_inv + 0.5f, t0 = tc * half_inv + 0.5f;
+    s = s0 > 0.f ? (s0 < 1.f ? s0 : 1.f) : 0.f;
+    t = t0 > 0.f ? (t0 < 1.f ? t0 : 1.f) : 0.f;
+}
+
+/// Convolves W output directions (one chunk of a face row): out[k] = factor * sum w L.
+template <std::size_t W>
+void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, vec3<float>* out) noexcept {
+    float tot[W][4], blk[W][4];
+    for (std::size_t k = 0; k < W; ++k)
+        for (int c = 0; c < 4; ++c) tot[k][c] = 0.f;
+    const float* data = src.data.data();
+    const std::size_t count = taps.w.size();
+    for (std::size_t b = 0; b < count; b += tap_block) {
+        for (std::size_t k = 0; k < W; ++k)
+            for (int c = 0; c < 4; ++c) blk[k][c] = 0.f;
+        const std::size_t e = b + tap_block < count ? b + tap_block : count;
+        for (std::size_t i = b; i < e; ++i) {
+            const float lx = taps.x[i], ly = taps.y[i], lz = taps.z[i], w = taps.w[i];
+            const packed_cube::level& lv = src.levels[std::size_t(taps.level[i])];
+            const float nf = lv.nf;
+            const int n = lv.n, st = lv.stride, fs = lv.face_stride, off = lv.offset;
+            int idx[W];
+            float wx[W], wy[W];
+            // Lane loop 1: rotate, select the face, address the 2 x 2 texels (branch-free).
+            for (std::size_t k = 0; k < W; ++k) {
+                const float dx = fr.tx[k] * lx + fr.bx[k] * ly + fr.nx[k] * lz;
+                const float dy = fr.ty[k] * lx + fr.by[k] * ly + fr.ny[k] * lz;
+                const float dz = fr.tz[k] * lx + fr.bz[k] * ly + fr.nz[k] * lz;
+                int face;
+                float s, t;
+                lane_cube_coord(dx, dy, dz, face, s, t);
+                const float fx = s * nf + 0.5f; // bordered coordinate, in [0.5, n + 0.5]
+                const float fy = t * nf + 0.5f;
+                const int ix = int(fx), iy = int(fy);
+                const int x0 = ix < n ? ix : n, y0 = iy < n ? iy : n;
+                wx[k] = fx - float(x0);
+                wy[k] = fy - float(y0);
+                idx[k] = off + face * fs + y0 * st + x0;
+            }
+            // Lane loop 2: bilinear blend (a + w (b - a), exact on equal texels) and accumulate,
+            // four channels at a time (RGB + padding).
+            for (std::size_t k = 0; k < W; ++k) {
+                const float* p = data + 4 * std::size_t(idx[k]);
+                const float* q = p + 4 * std::size_t(st);
+                const float a = wx[k], bw = wy[k];
+                for (int c = 0; c < 4; ++c) {
+                    const float top = p[c] + a * (p[4 + c] - p[c]);
+                    const float bot = q[c] + a * (q[4 + c] - q[c]);
+                    blk[k][c] += w * (top + bw * (bot - top));
+                }
+            }
+        }
+        for (std::size_t k = 0; k < W; ++k)
+            for (int c = 0; c < 4; ++c) tot[k][c] += blk[k][c];
+    }
+    for (std::size_t k = 0; k < W; ++k)
+        out[k] = vec3<float>(tot[k][0] * taps.factor, tot[k][1] * taps.factor, tot[k][2] * taps.factor);
+}
+
+/// Lane width of the fast path (a face row is processed in chunks of W, the tail at width 1).
+inline constexpr std::size_t convolve_width = 8;
+
+/// Convolves row y of face `face` of an n x n output level into out[0..n).
+inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
+    constexpr std::size_t W = convolve_width;
+    auto load = [&](auto& fr, std::size_t k, int x) {
+        const frame<float> f = make_frame(cube_texel_direction<float>(face, x, y, n));
+        fr.tx[k] = f.t.x, fr.ty[k] = f.t.y, fr.tz[k] = f.t.z;
+        fr.bx[k] = f.b.x, fr.by[k] = f.b.y, fr.bz[k] = f.b.z;
+        fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
+    };
+    int x = 0;
+    for (; x + int(W) <= n; x += int(W)) {
+        lane_frames<W> fr;
+        for (std::size_t k = 0; k < W; ++k) load(fr, k, x + int(k));
+        convolve_lanes<W>(src, taps, fr, out + x);
+    }
+    for (; x < n; ++x) {
+        lane_frames<1> fr;
+        load(fr, 0, x);
+        convolve_lanes<1>(src, taps, fr, out + x);
+    }
+}
+
+} // namespace detail
+
+} // namespace ibl
