@@ -102,7 +102,7 @@ const std::map<std::string, option_spec>& option_table() {
              o.part = v;
          }}},
         {"--input-layout", {true, [](bake_options& o, const std::string& v) {
-             o.input_layout = choice("--input-layout", v, {"auto", "latlong", "hcross", "vcross", "faces", "ktx2"});
+             o.input_layout = choice("--input-layout", v, {"auto", "latlong", "hcross", "vcross", "hstrip", "vstrip", "faces", "ktx2"});
          }}},
         {"--layout", {true, [](bake_options& o, const std::string& v) {
              o.layouts = choices("--layout", v, {"faces", "latlong", "cross", "octahedral"});
@@ -176,7 +176,8 @@ std::string usage_text() {
            "a preview and an error/time report from a lat-long HDR image or the built-in sky.\n\n"
            "  --input PATH       Radiance .hdr, OpenEXR or KTX2: lat-long (2:1), cross (4:3 or 3:4), or six faces\n"
            "                     (a path with {face}: px nx py ny pz nz); default: the built-in sky + sun\n"
-           "  --input-layout L   auto (default: from the aspect ratio) | latlong | hcross | vcross | faces | ktx2\n"
+           "  --input-layout L   auto (default: by aspect ratio) | latlong | hcross | vcross | hstrip | vstrip |\n"
+           "                     faces | ktx2\n"
            "  --part NAME        the part of a multi-part EXR (default: the first with R, G, B)\n"
            "  --max-input-pixels N  refuse larger inputs before decoding (default 134217728 = 16384 x 8192)\n"
            "  --out DIR          output directory (created; existing files of the same names replaced)\n"

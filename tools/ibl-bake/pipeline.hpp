@@ -43,18 +43,23 @@ using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 using sh3 = ibl::sh_coeffs<double, 3>;
 
-/// The environment the products are baked from: a lat-long image or the built-in sky + sun.
+/// The environment the products are baked from: the built-in sky + sun, a lat-long image or a
+/// cube (a cross, six faces or a KTX2 cubemap: source_input.hpp).
 struct source_env {
     std::string name;
     bool analytic = true;
     ibl::sky_environment<double> sky = ibl::make_default_sky<double>();
-    std::unique_ptr<ibl::latlong<float>> map;
+    std::unique_ptr<ibl::latlong<float>> map;  ///< lat-long inputs
+    std::unique_ptr<ibl::cubemap<float>> cube; ///< cube inputs (full mip chain)
+    std::string layout;                        ///< latlong, hcross, vcross, hstrip, vstrip, faces, ktx2
     read_report rr;
-    int width = 0, height = 0;
+    int width = 0, height = 0;                 ///< of the input image (a cube input: its face size)
 
-    /// Calls f with the environment (ibl::sky_environment<double> or ibl::latlong<float>).
+    /// Calls f with the environment (ibl::sky_environment<double>, ibl::latlong<float> or
+    /// ibl::cubemap<float>).
     template <class F> auto visit(F&& f) const {
         if (analytic) return f(sky);
+        if (cube) return f(*cube);
         return f(*map);
     }
 };

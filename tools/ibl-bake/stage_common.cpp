@@ -7,6 +7,7 @@
 #include <span>
 
 #include <ibl/core/color.hpp>
+#include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/prefilter.hpp>
@@ -64,6 +65,16 @@ dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level) {
                 }
             }
     return dir;
+}
+
+ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_executor& ex, int* k_used) {
+    int k = base_k;
+    if (src.cube) k = std::clamp(int(std::ceil(double(src.cube->size(0)) / double(n))), base_k, 32);
+    else if (!src.analytic) k = std::clamp(int(std::ceil(double(src.width) / (4.0 * n))), base_k, 32);
+    if (k_used) *k_used = src.cube && src.cube->size(0) == n ? 1 : k;
+    if (src.analytic) return ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), n, k, ex, 0);
+    if (src.cube) return src.cube->size(0) == n ? *src.cube : ibl::bake_cubemap<float>(*src.cube, n, k, ex, 0);
+    return ibl::bake_cubemap<float>(*src.map, n, k, ex, 0);
 }
 
 int level_at_most(const ibl::cubemap<float>& cube, int max_face) {

@@ -152,12 +152,7 @@ private:
 void compare_full_stage::bake_full(bake_context& ctx) {
     ctx.prog.begin("full bake");
     auto t0 = std::chrono::steady_clock::now();
-    const int n = ctx.full.source_size;
-    if (ctx.src.analytic) fsource_ = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), n, ctx.qs.bake_k, ctx.ex, 0);
-    else {
-        const int k = std::clamp(int(std::ceil(double(ctx.src.width) / (4.0 * n))), ctx.qs.bake_k, 32);
-        fsource_ = ibl::bake_cubemap<float>(*ctx.src.map, n, k, ctx.ex, 0);
-    }
+    fsource_ = bake_source(ctx.src, ctx.full.source_size, ctx.qs.bake_k, ctx.ex);
     tf_.source = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     fchain_ = bake_chain(fsource_, ctx.full.specular, ctx.ex);
@@ -225,7 +220,7 @@ void compare_full_stage::check_levels(bake_context& ctx) {
                 for (std::size_t i = b; i < e; ++i) {
                     const dvec3 d = ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n);
                     ref[i] = ctx.src.analytic ? ibl::reference_ld_sky(ctx.src.sky, d, lp.roughness, 2048, 16)
-                                              : ibl::reference_ld(*ctx.src.map, d, lp.roughness, 8192);
+                                              : ctx.src.visit([&](const auto& env) { return ibl::reference_ld(env, d, lp.roughness, 8192); });
                 }
             });
             ibl::error_accumulator acc(1e-3), acc_conv(1e-3);

@@ -1,9 +1,11 @@
 // tools/ibl-bake/stage_source.cpp — the source: the input lat-long (Radiance .hdr, OpenEXR) or the
-// built-in sky + sun, baked to a cube of the plan's source size by k x k supersampling with exact
-// spherical box mips (ibl::bake_cubemap). A lat-long input takes k >= W / (4 n), so that every
-// input texel reaches the cube (a face spans 90 degrees), at most 32.
+// built-in sky + sun, or a cube input (a cross, six faces, a KTX2 cubemap: source_input.hpp), baked
+// to a cube of the plan's source size by k x k supersampling with exact spherical box mips
+// (ibl::bake_cubemap: stages.hpp bake_source).
 
 #include "stages.hpp"
+
+#include "source_input.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -44,11 +46,8 @@ public:
         if (!ctx.opt.input.empty()) read_input(ctx);
         else ctx.src.name = "built-in sky + sun (ibl::make_default_sky)";
         size_ = ctx.plan.source_size;
-        k_ = ctx.qs.bake_k;
-        if (!ctx.src.analytic) k_ = std::clamp(int(std::ceil(double(ctx.src.width) / (4.0 * size_))), ctx.qs.bake_k, 32);
         ctx.prog.begin("source cube");
-        ctx.source = ctx.src.analytic ? ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size_, k_, ctx.ex, 0)
-                                      : ibl::bake_cubemap<float>(*ctx.src.map, size_, k_, ctx.ex, 0);
+        ctx.source = bake_source(ctx.src, size_, ctx.qs.bake_k, ctx.ex, &k_);
         cube_ms_ = ctx.prog.end();
         ctx.light = brightest_direction(ctx.source, 0);
         ctx.lstats = source_luminance(ctx.source);
@@ -60,7 +59,7 @@ public:
     std::vector<table_row> rows() const override {
         std::vector<table_row> r;
         if (!src_->analytic)
-            r.push_back({"input", src_->rr.format + " " + std::to_string(src_->width) + "x" + std::to_string(src_->height),
+            r.push_back({"input", src_->rr.format + " " + src_->layout + " " + std::to_string(src_->width) + "x" + std::to_string(src_->height),
                          std::to_string(src_->rr.negative_values) + " negative values clamped", read_ms_, "-"});
         r.push_back({"source cube", "supersampled bake + box mips",
                      std::to_string(size_) + "^2, " + std::to_string(k_) + "x" + std::to_string(k_) + " sub-samples", cube_ms_, "-"});
@@ -69,7 +68,8 @@ public:
 
     void report(json_writer& j) const override {
         j.begin_object();
-        j.key("kind").value(src_->analytic ? "analytic" : "latlong");
+        j.key("kind").value(src_->analytic ? "analytic" : src_->cube ? "cube" : "latlong");
+        if (!src_->analytic) j.key("layout").value(src_->layout);
         j.key("name").value(src_->name);
         if (!src_->analytic) {
             j.key("format").value(src_->rr.format);
@@ -91,13 +91,7 @@ public:
 private:
     void read_input(bake_context& ctx) {
         ctx.prog.begin("read input");
-        image_rgb32f img = read_latlong(ctx.opt.input, {}, &ctx.src.rr);
-        ctx.src.analytic = false;
-        ctx.src.name = ctx.opt.input;
-        ctx.src.width = img.width;
-        ctx.src.height = img.height;
-        ctx.src.map = std::make_unique<ibl::latlong<float>>(img.width, img.height, std::span<const float>(img.rgb), 1);
-        ctx.src.map->update_borders();
+        read_source(ctx.opt, ctx.src);
         read_ms_ = ctx.prog.end();
     }
 

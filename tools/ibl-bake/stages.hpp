@@ -78,6 +78,12 @@ int level_at_most(const ibl::cubemap<float>& cube, int max_face);
 std::vector<dvec3> texel_sum_irradiance(const ibl::cubemap<float>& cube, int level, const std::vector<dvec3>& normals,
                                         pool_executor& ex);
 
+/// The source cube of face n (full mip chain): the built-in sky, a lat-long or a cube input by k x k
+/// supersampling (ibl::bake_cubemap). k = base_k, raised so that every input texel reaches the
+/// cube: k >= W / (4 n) for a lat-long of width W (a face spans 90 degrees), k >= m / n for a cube
+/// of face m; at most 32. A cube input of face n is used as it is (a copy). *k_used: the k taken.
+ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_executor& ex, int* k_used = nullptr);
+
 /// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
 /// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, pool_executor& ex);

@@ -1,0 +1,73 @@
+// tools/ibl-bake/source_input.cpp — see source_input.hpp.
+
+#include "source_input.hpp"
+
+#include <span>
+
+#include "cube_layout.hpp"
+#include "ktx2.hpp"
+
+namespace ibl_bake {
+
+namespace {
+
+bool ends_with(const std::string& s, const std::string& suffix) {
+    if (s.size() < suffix.size()) return false;
+    std::string tail = s.substr(s.size() - suffix.size());
+    for (char& c : tail) c = char(std::tolower(static_cast<unsigned char>(c)));
+    return tail == suffix;
+}
+
+void set_cube(source_env& src, const cube_faces& faces, const std::string& format) {
+    src.analytic = false;
+    src.cube = std::make_unique<ibl::cubemap<float>>(cubemap_from_faces(faces));
+    src.width = src.height = faces.size;
+    src.layout = format;
+}
+
+read_options input_read_options(const bake_options& opt) {
+    read_options ro;
+    ro.max_pixels = opt.max_input_pixels;
+    return ro;
+}
+
+} // namespace
+
+void read_source(const bake_options& opt, source_env& src) {
+    src.name = opt.input;
+    const read_options ro = input_read_options(opt);
+    const bool faces = opt.input_layout == "faces" || (opt.input_layout == "auto" && opt.input.find("{face}") != std::string::npos);
+    const bool ktx2 = opt.input_layout == "ktx2" || (opt.input_layout == "auto" && ends_with(opt.input, ".ktx2"));
+    if (faces) {
+        std::array<read_report, 6> reports;
+        set_cube(src, read_face_files(opt.input, ro, &reports), "faces");
+        src.rr = reports[0];
+        for (int f = 1; f < 6; ++f) {
+            src.rr.negative_values += reports[std::size_t(f)].negative_values;
+            src.rr.max_value = std::max(src.rr.max_value, reports[std::size_t(f)].max_value);
+        }
+        return;
+    }
+    if (ktx2) {
+        const std::vector<unsigned char> bytes = read_file(opt.input);
+        set_cube(src, faces_from_ktx2(decode_ktx2_cubemap(bytes, opt.input), 0, opt.input), "ktx2");
+        src.rr.format = "KTX2";
+        return;
+    }
+    image_rgb32f img = read_image(opt.input, ro, &src.rr);
+    const std::optional<layout_choice> choice = parse_layout_choice(opt.input_layout);
+    const input_layout layout = resolve_layout(img.width, img.height, choice ? *choice : layout_choice::automatic, opt.input);
+    src.analytic = false;
+    if (layout != input_layout::latlong) {
+        set_cube(src, faces_from_layout(img, layout, opt.input), layout_name(layout));
+        src.width = img.width, src.height = img.height;
+        return;
+    }
+    src.layout = "latlong";
+    src.width = img.width;
+    src.height = img.height;
+    src.map = std::make_unique<ibl::latlong<float>>(img.width, img.height, std::span<const float>(img.rgb), 1);
+    src.map->update_borders();
+}
+
+} // namespace ibl_bake
