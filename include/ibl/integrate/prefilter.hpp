@@ -53,6 +53,9 @@
 // Determinism: the output depends only on the source and the options; each texel is computed by
 // the same operations whatever the executor (work items are face rows).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -63,7 +66,6 @@
 #include <vector>
 
 #include "../brdf/ggx.hpp"
-#include "../core/config.hpp"
 #include "../core/executor.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -229,3 +231,5 @@ cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Exec
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -32,6 +32,9 @@
 //   sky without its sun plus the sun's cap integral of max(n.l, 0) by the same cap rule (exact
 //   also when the cap straddles n's horizon, unlike sky_environment::sun_irradiance).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -195,3 +198,5 @@ std::vector<vec3<double>> reference_faces(int n, F&& fn, Executor&& ex = Executo
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20
