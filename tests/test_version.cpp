@@ -4,7 +4,6 @@
 #include <ibl/core/config.hpp>
 
 #include <fstream>
-#include <regex>
 #include <sstream>
 #include <string>
 
@@ -33,8 +32,11 @@ TEST_CASE("version: the package version file (iblConfigVersion.cmake) carries th
     std::stringstream text;
     text << in.rdbuf();
     const std::string s = text.str();
-    std::smatch m;
-    REQUIRE(std::regex_search(s, m, std::regex("set\\(PACKAGE_VERSION \"([^\"]*)\"\\)")));
-    CHECK(m[1].str() == IBL_VERSION_STRING);
+    const std::string key = "set(PACKAGE_VERSION \"";
+    const std::size_t begin = s.find(key);
+    REQUIRE(begin != std::string::npos);
+    const std::size_t end = s.find('"', begin + key.size());
+    REQUIRE(end != std::string::npos);
+    CHECK(s.substr(begin + key.size(), end - begin - key.size()) == IBL_VERSION_STRING);
 }
 #endif
