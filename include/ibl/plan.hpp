@@ -119,6 +119,9 @@
 //   or error target, an error target <= 0, a scene without materials and max_reflection_pixels < 1
 //   throw std::invalid_argument. metallic outside [0, 1] is clamped with a warning.
 
+#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -590,3 +593,5 @@ inline std::vector<std::string> left_out(const bake_plan& plan, const bake_plan&
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -79,11 +79,13 @@
 //   and a light at the shading point give 0, never NaN. For finite inputs every function here
 //   returns finite values for r in {0, 1} and n.v in {0, 1} included.
 
+#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "brdf/fresnel.hpp"
 #include "brdf/ggx.hpp"
 #include "brdf/lambert.hpp"
 #include "brdf/masking.hpp"
-#include "core/config.hpp"
 #include "core/constants.hpp"
 #include "core/math.hpp"
 #include "core/vec.hpp"
@@ -357,3 +359,5 @@ template <class T> struct pbr_shader {
 };
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

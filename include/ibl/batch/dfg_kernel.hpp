@@ -17,12 +17,14 @@
 // with w = M::sample_weight(n.v, n.l, n.h, v.h, r) (brdf/model.hpp): f n.l / pdf_l / F for a half
 // vector drawn from the GGX NDF, 0 below the horizon.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
 #include "../brdf/model.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "detail/lane_math.hpp"
@@ -213,3 +215,5 @@ inline void dfg_quadrature_lanes(const dfg_quadrature_view& q, double roughness,
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -22,10 +22,12 @@
 //  * convolve_row: one face row in chunks of convolve_width lanes, the tail at width 1.
 // Determinism: every output texel is a fixed sequence of operations on the taps and the source.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <vector>
 
-#include "../core/config.hpp"
 #include "../core/frame.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -213,3 +215,5 @@ inline void convolve_row(const packed_cube& src, const tap_table& taps, int face
 } // namespace detail
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -13,9 +13,11 @@
 // and the peak stays finite); exponent to [0, blinn_phong_max_exponent_v] (NaN -> 0); n.h to [0, 1]
 // with D = 0 for n.h < 0, as ndf_ggx.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -70,3 +72,5 @@ template <class T> IBL_FUNC T ndf_blinn_phong(const vec3<T>& h, T alpha) noexcep
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

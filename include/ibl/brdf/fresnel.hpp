@@ -20,9 +20,11 @@
 // (NaN -> 0); IORs to [0, ior_max_v] (NaN -> 0). F0, F90 and colours are used as given (the results
 // are affine in them, so finite inputs give finite results).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <limits>
 
-#include "../core/config.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 
@@ -100,3 +102,5 @@ template <class T> IBL_FUNC vec3<T> diffuse_from_metallic(const vec3<T>& base_co
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

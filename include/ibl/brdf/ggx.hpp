@@ -15,7 +15,9 @@
 // double), so no intermediate of D underflows and the peak D = 1/(pi alpha^2) stays finite
 // (at most 1.5e18 in float). Integrators detect the mirror regime with ggx_effectively_smooth.
 
-#include "../core/config.hpp"
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -101,3 +103,5 @@ template <class T> IBL_FUNC bool ggx_effectively_smooth(T alpha) noexcept {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

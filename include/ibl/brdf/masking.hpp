@@ -24,7 +24,9 @@
 // Domain clamps (the stability contract): cosines are clamped to [0, 1] (NaN -> 0); roughness to
 // [0, 1] (NaN -> 0); alpha to [ggx_min_alpha_v, 1] (clamp_alpha); k to [schlick_min_k_v, 1].
 
-#include "../core/config.hpp"
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "ggx.hpp"
@@ -114,3 +116,5 @@ template <class T> IBL_FUNC T v_smith_ggx_correlated(T n_dot_v, T n_dot_l, T alp
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -39,9 +39,11 @@
 // Writing a model: copy ggx_height_correlated, change ndf / visibility / sample_weight, and
 // static_assert(ibl::brdf_model<my_model, float> && ibl::brdf_model<my_model, double>).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <concepts>
 
-#include "../core/config.hpp"
 #include "../core/math.hpp"
 #include "ggx.hpp"
 #include "masking.hpp"
@@ -113,3 +115,5 @@ static_assert(brdf_model<ggx_schlick_ibl, float> && brdf_model<ggx_schlick_ibl, 
 static_assert(brdf_model<ggx_height_correlated, float> && brdf_model<ggx_height_correlated, double>);
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -1,7 +1,9 @@
 #pragma once
 // ibl/core/color.hpp — colour helpers for linear RGB with Rec. 709 / sRGB primaries.
 
-#include "config.hpp"
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "vec.hpp"
 
 namespace ibl {
@@ -12,3 +14,5 @@ template <class T> IBL_FUNC T luminance(const vec3<T>& rgb) noexcept {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -2,6 +2,9 @@
 // ibl/core/constants.hpp — mathematical constants as variable templates over the scalar type,
 // and the named numerical thresholds that the stability contract relies on.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <limits>
 
 namespace ibl {
@@ -27,3 +30,5 @@ template <class T> inline constexpr T epsilon_v = std::numeric_limits<T>::epsilo
 template <class T> inline constexpr T min_normal_v = std::numeric_limits<T>::min();
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -11,6 +11,9 @@
 // independently, and reductions go through parallel_reduce_blocks, which fixes the block size
 // from the problem (not from the executor) and combines block results in block order.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <thread>
 #include <vector>
@@ -63,3 +66,5 @@ R parallel_reduce_blocks(Executor&& ex, std::size_t blocks, R init, BlockFn&& bl
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

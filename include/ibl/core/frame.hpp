@@ -9,7 +9,9 @@
 //
 // Local (tangent) space: x = t, y = b, z = n; to_local/to_world are the two rotations.
 
-#include "config.hpp"
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "math.hpp"
 #include "vec.hpp"
 
@@ -37,3 +39,5 @@ template <class T> IBL_FUNC frame<T> make_frame(const vec3<T>& n) noexcept {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

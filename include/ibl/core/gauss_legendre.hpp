@@ -10,6 +10,9 @@
 // 2 / ((1 - z^2) P_n'(z)^2) halved for the unit interval (A. H. Stroud, D. Secrest, "Gaussian
 // Quadrature Formulas", 1966). Nodes ascend; the rule is symmetric about 1/2 to rounding.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <vector>
@@ -73,3 +76,5 @@ inline gauss_legendre_rule make_gauss_legendre(std::size_t n) {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -2,9 +2,11 @@
 // ibl/core/math.hpp — the named edge-case helpers. Raw sqrt(1 - x*x) or max(0, ...) does not
 // appear outside core/; callers use these so that the clamp and its reason live in one place.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "config.hpp"
 #include "constants.hpp"
 
 namespace ibl {
@@ -82,3 +84,5 @@ template <class T> IBL_FUNC bool is_finite(T x) noexcept {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

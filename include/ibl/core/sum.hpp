@@ -9,10 +9,12 @@
 // pairwise_sum: recursive halving with a block of 8 naive additions at the leaves; error
 // O(eps log n) sum|x_i|, no extra state, and vectorises. Used where a whole array is at hand.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <cmath>
 
-#include "config.hpp"
 
 namespace ibl {
 
@@ -54,3 +56,5 @@ template <class T> IBL_FUNC T pairwise_sum(const T* x, std::size_t n) noexcept {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

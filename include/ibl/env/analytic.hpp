@@ -25,11 +25,13 @@
 //
 // lambda_environment     adapts a callable dir -> vec3<T> (radiance only; texel_solid_angle 0).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <type_traits>
 #include <utility>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -147,3 +149,5 @@ static_assert(environment<constant_environment<float>, float>);
 static_assert(environment<sky_environment<double>, double>);
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -14,6 +14,9 @@
 // quadrature error O((1 / (n k))^2) per texel; a hard-edged feature (a sun disk) is resolved to
 // 1 / k^2 of a texel's area.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <stdexcept>
@@ -82,3 +85,5 @@ cubemap<T> bake_cubemap(const Env& env, int n, int k, Executor&& ex = Executor{}
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

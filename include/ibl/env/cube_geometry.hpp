@@ -25,9 +25,11 @@
 // antiderivative is F(a, b) = atan(a b / sqrt(1 + a^2 + b^2)); the rectangle's solid angle is
 // F(a1,b1) - F(a0,b1) - F(a1,b0) + F(a0,b0). The six faces sum to 4 pi.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/vec.hpp"
 
@@ -119,3 +121,5 @@ template <class T> IBL_FUNC T cube_texel_solid_angle(int x, int y, int n) noexce
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

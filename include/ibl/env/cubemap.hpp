@@ -46,6 +46,9 @@
 // log-linearly in between (= Omega_0 4^lod for power-of-two chains); lod_for_solid_angle is its
 // exact inverse. exact_texel_solid_angle(x, y, level) gives the true (non-uniform) value.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -54,7 +57,6 @@
 #include <vector>
 
 #include "detail/level_solid_angle.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/math.hpp"
@@ -386,3 +388,5 @@ static_assert(environment<cubemap<float>, float>);
 static_assert(environment<cubemap<double>, double>);
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

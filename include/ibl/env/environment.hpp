@@ -20,11 +20,13 @@
 //       Filtered importance sampling (Krivanek & Colbert 2008) reads a sample from the lod whose
 //       texel solid angle equals the sample's solid angle 1 / (N pdf); this is that lod.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <concepts>
 #include <type_traits>
 
-#include "../core/config.hpp"
 #include "../core/vec.hpp"
 
 namespace ibl {
@@ -80,3 +82,5 @@ struct environment_scalar<E> {
 template <class E> using environment_scalar_t = typename detail::environment_scalar<E>::type;
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -35,6 +35,9 @@
 // Mutation as for cubemap: write texels, then generate_mips() or update_borders() before lookups.
 // Data from files may hold NaN/inf or small negative values (lossy EXR): sanitize() them first.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <span>
@@ -44,7 +47,6 @@
 #include <vector>
 
 #include "detail/level_solid_angle.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/math.hpp"
@@ -346,3 +348,5 @@ cubemap<T> latlong_to_cubemap(const latlong<T>& src, int n, int k, Executor&& ex
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -41,13 +41,15 @@
 // (dfg_smooth_limit); the quadrature reaches it by itself (the whole lobe lies below the y cap).
 // mu -> 0 stays finite: the weight is finite for n.v = 0 in every shipped model.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
 #include "../batch/dfg_kernel.hpp"
 #include "../brdf/model.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -226,3 +228,5 @@ template <class Model, class T> vec2<T> dfg_mc_vndf(T n_dot_v, T roughness, std:
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

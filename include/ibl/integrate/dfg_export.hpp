@@ -11,6 +11,9 @@
 // Every value is printed with 9 significant digits (std::numeric_limits<float>::max_digits10), so
 // the compiled array equals the table bit for bit.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <ios>
 #include <limits>
@@ -65,3 +68,5 @@ inline std::string dfg_lut_header(const dfg_lut& lut, std::string_view name, std
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

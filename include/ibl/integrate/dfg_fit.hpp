@@ -8,9 +8,11 @@
 //   a004 = min(r.x^2, exp2(-9.28 n.v)) r.x + r.y,  (A, B) = (-1.04, 1.04) a004 + r.zw.
 // Largest absolute error against the exact 128^2 table (texel centres): see bench/bench_dfg.cpp.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 
@@ -30,3 +32,5 @@ template <class T> IBL_FUNC vec2<T> dfg_karis_mobile(T n_dot_v, T roughness) noe
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

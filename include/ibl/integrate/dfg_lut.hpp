@@ -16,6 +16,9 @@
 // Carlo), the remainder at W = 1. Which texels share a kernel call depends only on size, never on
 // the executor, so the table is bit-identical for every partition and thread count.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -135,3 +138,5 @@ dfg_lut make_dfg_lut_mc(std::uint32_t size, std::uint32_t samples, std::uint32_t
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

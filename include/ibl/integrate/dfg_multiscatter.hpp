@@ -22,7 +22,9 @@
 //      Fms = FssEss Favg / (1 - Ems Favg);  specular = FssEss + Fms Ems
 //    (specular_dfg_fdez_aguera). With F0 = 1 it is Ess + 1 - Ess = 1. It needs no third channel.
 
-#include "../core/config.hpp"
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "dfg.hpp"
@@ -63,3 +65,5 @@ template <class T> IBL_FUNC vec3<T> specular_dfg_fdez_aguera(const vec2<T>& ab, 
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -38,6 +38,9 @@
 // The baked cube is then only the proposal; integrators still evaluate the analytic radiance.
 // Lat-long maps: bake_cubemap(latlong, n, k) likewise (the proposal need not be the integrand).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -227,3 +230,5 @@ cube_env_distribution make_cube_env_distribution(const Env& env, int n, int k,
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

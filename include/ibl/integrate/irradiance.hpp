@@ -32,6 +32,9 @@
 // size `size` (32 by default: irradiance is smooth, its spectrum ends at SH band 2 to within 1%).
 // Non-finite radiance reads as 0; samples = 0 (or n_theta, n_phi = 0) are clamped to 1.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -141,3 +144,5 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -17,6 +17,9 @@
 // Non-finite elements of a make max_abs, rmse, ... infinite/NaN (they are errors, not skipped);
 // `nonfinite` counts them.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <limits>
@@ -123,3 +126,5 @@ template <class A, class B>
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -86,6 +86,9 @@
 //   `scalar_type` member if present, else double when it models environment<E, double>, else
 //   float), converted to double. Radiance must be finite and non-negative for the bounds above.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <concepts>
 #include <cstddef>
@@ -98,7 +101,6 @@
 #include "../brdf/ggx.hpp"
 #include "../brdf/model.hpp"
 #include "../core/color.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
@@ -483,3 +485,5 @@ radiance_estimate reference_radiance(const Env& env, const cube_env_distribution
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -44,6 +44,9 @@
 //   memory 2 x 6 n^2 vec3<double> (1.2 MB at n = 64). irradiance_texel_sum_level(cube, max_face)
 //   picks the first level whose face is <= max_face (bounding the cost per normal).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -270,3 +273,5 @@ std::vector<vec3<double>> reference_faces(int n, F&& fn, Executor&& ex = Executo
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

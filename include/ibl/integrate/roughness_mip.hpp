@@ -17,9 +17,11 @@
 // Domains: r in [0, 1] (clamped, NaN -> 0); lod in [0, m] (clamped, NaN -> 0). A chain of one
 // level (m = 0) holds r = 0 only: roughness() returns 0 and lod() returns 0.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/math.hpp"
 
 namespace ibl {
@@ -63,3 +65,5 @@ struct roughness_mip_policy {
 };
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -28,6 +28,9 @@
 // Determinism: every output texel is a fixed sequence of operations on the table and the source;
 // the work partition (executor) never changes a result.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -35,7 +38,6 @@
 #include <vector>
 
 #include "../batch/sphere_kernel.hpp"
-#include "../core/config.hpp"
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
 #include "../core/math.hpp"
@@ -147,3 +149,5 @@ std::vector<vec3<float>> convolve_faces(const Env& env, const sphere_sample_tabl
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

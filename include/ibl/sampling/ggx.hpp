@@ -33,11 +33,13 @@
 // Every function is finite for u in [0, 1)^2 (including the corner 1 - eps/2), alpha in [0, 1]
 // and unit v with v.z in [0, 1], including v.z = 0 exactly.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <limits>
 
 #include "../brdf/ggx.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -225,3 +227,5 @@ template <class T> IBL_FUNC vec2<T> invert_ggx_vndf(const vec3<T>& v, const vec3
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -12,9 +12,11 @@
 // M. Pharr, W. Jakob, G. Humphreys, "Physically Based Rendering", 4th ed., 2023, sec. A.5.1);
 // Malley's method for the cosine lobe (PBR 4th ed., sec. A.5.3).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -145,3 +147,5 @@ template <class T> IBL_FUNC vec2<T> invert_cosine_hemisphere(const vec3<T>& w) n
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

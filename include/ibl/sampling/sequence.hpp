@@ -13,9 +13,11 @@
 // 32-bit fraction is truncated to its top 24 bits (k / 2^24), so it never rounds up to 1.
 // Integer arithmetic only (no intrinsics): the same code runs in CUDA device code.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstdint>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/vec.hpp"
 
@@ -103,3 +105,5 @@ IBL_FUNC constexpr vec2<T> hammersley_owen(std::uint32_t i, std::uint32_t n, std
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -49,10 +49,12 @@
 //
 // The polynomials assume |dir| = 1 (3z^2 - 1 stands for 3z^2 - |dir|^2); callers normalise.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <span>
 
-#include "../core/config.hpp"
 #include "../core/vec.hpp"
 
 namespace ibl {
@@ -264,3 +266,5 @@ IBL_FUNC sh_coeffs<T, B> sh_project_directional(const vec3<T>& dir, const vec3<T
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

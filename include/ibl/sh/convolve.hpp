@@ -29,9 +29,11 @@
 //                                     E/pi is the diffuse "irradiance over pi" that multiplies
 //                                     albedo directly (Lambert BRDF = albedo/pi).
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <glm/mat4x4.hpp>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/vec.hpp"
 #include "basis.hpp"
@@ -144,3 +146,5 @@ template <class T, int B> IBL_FUNC vec3<T> sh_shader_evaluate(const sh_coeffs<T,
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

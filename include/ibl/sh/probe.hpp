@@ -12,9 +12,11 @@
 //   Scattered probes: inverse-distance weights w_i = d_i^-power / sum_j d_j^-power (Shepard);
 //       a probe at distance 0 (exactly) takes the whole weight. Interpolates the probe values.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
-#include "../core/config.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "basis.hpp"
@@ -99,3 +101,5 @@ IBL_FUNC sh_coeffs<T, B> sh_interpolate_idw(const vec3<T>& p, const vec3<T>* pos
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -51,6 +51,9 @@
 // a and c are even, and then to a polynomial of degree a + b + c in y, so the product rule is
 // exact for every polynomial of degree <= D on each hemisphere. 2N M directions in total.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cmath>
 #include <concepts>
@@ -61,7 +64,6 @@
 #include <vector>
 
 #include "../core/gauss_legendre.hpp"
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/math.hpp"
@@ -386,3 +388,5 @@ sh_coeffs<T, B> project_function(const F& f, int degree, Executor&& ex = {}) {
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

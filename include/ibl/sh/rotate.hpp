@@ -16,11 +16,13 @@
 // needs our basis to be the real SH without Condon-Shortley phase (basis.hpp), which it is;
 // tests/test_sh.cpp checks Y(R d) = D Y(d) for every band at random R, d.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 
 #include <glm/mat3x3.hpp>
 
-#include "../core/config.hpp"
 #include "../core/vec.hpp"
 #include "basis.hpp"
 
@@ -110,3 +112,5 @@ IBL_FUNC sh_coeffs<T, B> sh_rotate(const sh_coeffs<T, B>& c, const glm::mat<3, 3
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -22,10 +22,12 @@
 // whose basins are far wider than the 0.06 rad spacing of the default 4096 samples, so the
 // sampled basin is the global one and the refinement finds its minimum to ~1e-6 rad.
 
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <limits>
 
-#include "../core/config.hpp"
 #include "../core/constants.hpp"
 #include "../core/frame.hpp"
 #include "../core/math.hpp"
@@ -197,3 +199,5 @@ IBL_FUNC sh_auto_window_result<T, B> sh_auto_window(const sh_coeffs<T, B>& radia
 }
 
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

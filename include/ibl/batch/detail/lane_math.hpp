@@ -4,12 +4,14 @@
 // library without -ffast-math), so the kernels use these polynomial forms instead. Each states its
 // domain and its error; all are pure arithmetic, selects and (for exp) an exponent-field build.
 
+#include "../../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <utility>
 
-#include "../../core/config.hpp"
 #include "../../core/constants.hpp"
 #include "../../core/math.hpp"
 
@@ -95,3 +97,5 @@ IBL_FUNC double lane_expm1_nonneg(double y) noexcept {
 }
 
 } // namespace ibl::detail
+
+#endif // IBL_DETAIL_CXX20

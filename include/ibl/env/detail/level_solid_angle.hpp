@@ -7,6 +7,9 @@
 // interpolated log-linearly, so Omega(lod) = Omega_0 4^lod for a power-of-two chain, and
 // lod_for_solid_angle is its exact inverse.
 
+#include "../../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cmath>
 #include <cstddef>
 
@@ -48,3 +51,5 @@ template <class V> bool sanitize_texel(V& v, bool zero_negative) noexcept {
 }
 
 } // namespace ibl::detail
+
+#endif // IBL_DETAIL_CXX20

@@ -8,6 +8,9 @@
 // exact for any n, m (power of two or not); positions are given as doubles (exact when n m is a
 // power of two, else correctly rounded).
 
+#include "../../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <algorithm>
 #include <cstddef>
 #include <vector>
@@ -58,3 +61,5 @@ inline int full_chain_levels(int size) {
 }
 
 } // namespace ibl::detail
+
+#endif // IBL_DETAIL_CXX20
