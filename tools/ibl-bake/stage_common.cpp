@@ -135,6 +135,29 @@ void write_text(const std::string& path, const std::string& text) {
     write_file_atomic(path, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
 }
 
+ktx2_format ktx2_format_named(const std::string& name) {
+    if (name == "rgba32f") return ktx2_format::rgba32f;
+    if (name == "b10g11r11") return ktx2_format::b10g11r11;
+    if (name == "e5b9g9r9") return ktx2_format::e5b9g9r9;
+    return ktx2_format::rgba16f;
+}
+
+void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format) {
+    j.begin_object();
+    j.key("format").value(format);
+    j.key("relative_to").value("max(|x|, floor), floor = 1e-3 x the level's mean |x|");
+    j.key("levels").begin_array();
+    for (const auto& l : q) {
+        j.begin_object();
+        j.key("level").value(l.level).key("face_size").value(l.face_size).key("values").value(l.values);
+        j.key("floor").value(l.floor).key("max_rel_error").value(l.max_rel_error).key("rms_rel_error").value(l.rms_rel_error);
+        j.key("above_range").value(l.above_range).key("negative_clamped").value(l.negative_clamped).key("nan").value(l.nan);
+        j.end_object();
+    }
+    j.end_array();
+    j.end_object();
+}
+
 void json_triples(json_writer& j, const sh3& c, int count) {
     j.begin_array();
     for (int k = 0; k < count; ++k) {

@@ -1,7 +1,8 @@
 // tools/ibl-bake/stage_plan.cpp — the plan: which products, levels, sizes and samples are baked.
 //
 // Full bake: ibl::full_bake_plan over the tool's chain (--size, --levels, linear policy) with the
-// quality's samples, doubled per coarser level (level l >= 1: samples * 2^(l-1), at most 16384).
+// quality's samples, doubled per coarser level (ibl::doubling_prefilter_samples: level l >= 1
+// takes samples * 2^(l-1), at most 16384; the library's default schedule from 512).
 // Level l has 4^-l of the base's texels, so the whole chain costs less than twice level 1, while
 // the rough levels, where a sun is smeared over many texels and shows as mottle, get many more
 // samples. --scene: ibl::make_bake_plan of the scene over the same chain; the report says what the
@@ -10,6 +11,8 @@
 #include "stages.hpp"
 
 #include <algorithm>
+
+#include <ibl/integrate/prefilter.hpp>
 
 #include "scene_reader.hpp"
 
@@ -57,7 +60,7 @@ void plan_json(json_writer& j, const ibl::bake_plan& p, const ibl::plan_cost& c)
 ibl::bake_plan tool_full_plan(const ibl::plan_settings& set, const quality_settings& qs, int lut_size) {
     ibl::bake_plan p = ibl::full_bake_plan(set, qs.prefilter_samples, qs.trilinear, lut_size);
     for (std::size_t l = 1; l < p.specular.levels.size(); ++l)
-        p.specular.levels[l].samples = std::min<std::uint32_t>(qs.prefilter_samples << (l - 1), 16384u);
+        p.specular.levels[l].samples = ibl::doubling_prefilter_samples(qs.prefilter_samples, int(l));
     return p;
 }
 

@@ -19,6 +19,7 @@
 #include <ibl/integrate/reference.hpp>
 
 #include "check_texels.hpp"
+#include "cube_layout.hpp"
 
 namespace ibl_bake {
 
@@ -52,7 +53,9 @@ public:
         sp_ = ctx.plan.specular;
         analytic_ = ctx.src.analytic;
         qs_ = ctx.qs;
-        ktx2_f32_ = ctx.opt.ktx2_f32;
+        format_ = ctx.opt.ktx2_format;
+        layouts_ = ctx.opt.layouts;
+        quant_ = ktx2_quantisation_report(ktx_cube(*chain_), ktx2_format_named(format_));
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
         ctx.prog.begin("check specular");
         for (int k = 0; k < chain_->levels(); ++k) {
@@ -72,7 +75,10 @@ private:
 
     const ibl::cubemap<float>* chain_ = nullptr;
     ibl::specular_plan sp_;
-    bool analytic_ = true, ktx2_f32_ = false;
+    bool analytic_ = true;
+    std::string format_;
+    std::vector<std::string> layouts_;
+    std::vector<ktx2_quantisation_level> quant_;
     quality_settings qs_{};
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
     std::vector<level_check> checks_;
@@ -129,6 +135,14 @@ std::vector<table_row> specular_stage::rows() const {
                     worst_rel > 0.0 || checks_.size() > 1
                         ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) + fmt(", max overshoot %.3g", worst_over)
                         : "-"});
+    double qmax = 0.0, qrms = 0.0;
+    std::size_t clamped = 0;
+    for (const auto& q : quant_) {
+        qmax = std::max(qmax, q.max_rel_error), qrms = std::max(qrms, q.rms_rel_error);
+        clamped += q.above_range + q.negative_clamped + q.nan;
+    }
+    rows.push_back({"  specular.ktx2", format_ + " storage vs float", std::to_string(quant_.size()) + " levels", -1.0,
+                    fmt2("max rel %.3g, worst level rms rel %.3g", qmax, qrms) + ", " + std::to_string(clamped) + " values clamped"});
     for (const auto& c : checks_) {
         char name[64];
         std::snprintf(name, sizeof name, "  l%d %dx%d r=%.2f", c.level, c.size, c.size, c.roughness);
@@ -143,20 +157,35 @@ std::vector<table_row> specular_stage::rows() const {
 
 std::vector<file_out> specular_stage::files() const {
     std::vector<file_out> f;
-    for (int l = 0; l < chain_->levels(); ++l)
-        for (int face = 0; face < 6; ++face)
-            f.push_back({"specular_l" + std::to_string(l) + "_" + face_names[face] + ".exr",
-                         [this, l, face](const std::string& p) { write_exr(p, face_image(*chain_, face, l)); }});
+    const auto has = [&](const char* l) { return std::find(layouts_.begin(), layouts_.end(), l) != layouts_.end(); };
+    for (int l = 0; l < chain_->levels(); ++l) {
+        const std::string base = "specular_l" + std::to_string(l) + "_";
+        if (has("faces"))
+            for (int face = 0; face < 6; ++face)
+                f.push_back({base + face_names[face] + ".exr",
+                             [this, l, face](const std::string& p) { write_exr(p, face_image(*chain_, face, l)); }});
+        if (has("latlong")) f.push_back({base + "latlong.exr", [this, l](const std::string& p) { write_exr(p, latlong_from_cube(*chain_, l)); }});
+        if (has("cross"))
+            f.push_back({base + "cross.exr",
+                         [this, l](const std::string& p) { write_exr(p, cross_from_faces(faces_from_cubemap(*chain_, l))); }});
+        if (has("octahedral"))
+            f.push_back({base + "octahedral.exr", [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l)); }});
+    }
     f.push_back({"specular.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, ktx_cube(*chain_), ktx2_f32_ ? ktx2_format::rgba32f : ktx2_format::rgba16f,
-                                        "ibl-bake " + version_string());
+                     write_ktx2_cubemap(p, ktx_cube(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string());
                  }});
     return f;
 }
 
 void specular_stage::report(json_writer& j) const {
     j.begin_object();
-    j.key("files").value("specular_l{level}_{px,nx,py,ny,pz,nz}.exr, specular.ktx2");
+    j.key("files").value("specular_l{level}_{px,nx,py,ny,pz,nz}.exr (layout faces), specular_l{level}_{latlong,cross,octahedral}.exr "
+                         "(those layouts), specular.ktx2");
+    j.key("layouts").begin_array();
+    for (const auto& l : layouts_) j.value(l);
+    j.end_array();
+    j.key("ktx2_quantisation");
+    json_quantisation(j, quant_, format_);
     j.key("method").value(std::string("GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R");
     j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? sp_.levels[1].samples : 0u);

@@ -40,9 +40,7 @@ std::unique_ptr<stage> make_compare_full_stage();
 using bake_model = ibl::ggx_height_correlated;
 
 /// The package version (include/ibl/core/config.hpp), e.g. "0.1.0".
-inline std::string version_string() {
-    return std::to_string(ibl::version_major) + "." + std::to_string(ibl::version_minor) + "." + std::to_string(ibl::version_patch);
-}
+inline std::string version_string() { return IBL_VERSION_STRING; }
 
 inline constexpr const char* face_names[6] = {"px", "nx", "py", "ny", "pz", "nz"};
 
@@ -95,6 +93,13 @@ diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
 image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level);
 cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& cube);
 void write_text(const std::string& path, const std::string& text);
+
+/// The KTX2 format named by --ktx2-format (rgba16f, rgba32f, b10g11r11, e5b9g9r9).
+ktx2_format ktx2_format_named(const std::string& name);
+
+/// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
+/// the decoded values, values above the format's range and negatives clamped) as a JSON object.
+void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
 void json_triples(json_writer& j, const sh3& c, int count);
