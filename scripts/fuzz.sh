@@ -29,12 +29,12 @@ cp "$ROOT"/tests/data/*.exr "$OUT/seeds/"
 find "$SRC/tests/data" -name 'fuzz-*' -exec cp {} "$OUT/seeds/" \; 2>/dev/null || true
 ls -l "$OUT/seeds"
 
-echo "== fuzzing: $RUNS executions, one job"
+echo "== fuzzing: $RUNS executions, one process"
 export ASAN_OPTIONS=${ASAN_OPTIONS:-detect_leaks=1:allocator_may_return_null=1}
 export UBSAN_OPTIONS=${UBSAN_OPTIONS:-print_stacktrace=1:halt_on_error=1}
 START=$(date +%s)
 "$OUT/fuzz_image_readers" "$OUT/corpus" "$OUT/seeds" \
-    -runs="$RUNS" -max_len=65536 -timeout=10 -rss_limit_mb=2048 -jobs=1 -workers=1 \
+    -runs="$RUNS" -max_len=65536 -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$OUT/artifacts/" -print_final_stats=1 2>&1 | tee "$OUT/fuzz.log" | grep -E '^#|INFO|ERROR|SUMMARY|stat::|Done' | tail -40
 STATUS=${PIPESTATUS[0]}
 END=$(date +%s)

@@ -407,7 +407,7 @@ std::vector<exr_part_scan> scan_exr_headers(std::span<const unsigned char> b, co
             const std::string_view attr = r.name(max_name, where);
             if (attr.empty()) break;
             const std::string what = "attribute '" + printable(attr) + "'";
-            const std::string_view type = r.name(max_name, what);
+            const std::string_view type = r.name(max_name, "the type name of " + what);
             const std::int32_t size = r.i32(what);
             if (size < 0) r.fail(what + " has a negative size");
             r.need(std::size_t(size), what);
