@@ -5,11 +5,9 @@
 //   stb (libstb-dev): compiled here, from the headers, as static functions (STB_*_STATIC) so
 //     that they cannot clash with another copy (libstb.so) in the same program; no stdio entry
 //     points (the tool reads whole files itself and decodes from memory).
-//   tinyexr (libtinyexr-dev): Debian ships it prebuilt (libtinyexr.so, zlib for ZIP, built-in
-//     PIZ) with a CMake config (tinyexr::tinyexr), so by default only the declarations are
-//     included and the library is linked. Defining IBL_BAKE_TINYEXR_IMPLEMENTATION compiles the
-//     implementation from the same header instead (with zlib): the fuzz build does this so that
-//     tinyexr's code is instrumented for coverage and for AddressSanitizer.
+//   OpenEXR 3 (libopenexr-dev, with Imath): linked as OpenEXR::OpenEXR. Its decoders read from
+//     memory through span_istream (an Imf::IStream over the caller's bytes), so files and the
+//     fuzz harness share one code path; encode_exr writes through vector_ostream.
 
 #include "image_io.hpp"
 
@@ -50,10 +48,19 @@
 // (not STBI_WRITE_NO_STDIO: Debian's stb_image_write.h of 2022-09 then omits the HDR writer)
 #include <stb_image_write.h>
 
-#ifdef IBL_BAKE_TINYEXR_IMPLEMENTATION
-#define TINYEXR_IMPLEMENTATION
-#endif
-#include <tinyexr.h>
+#include <ImfChannelList.h>
+#include <ImfFrameBuffer.h>
+#include <ImfHeader.h>
+#include <ImfIO.h>
+#include <ImfInputPart.h>
+#include <ImfMultiPartInputFile.h>
+#include <ImfOutputFile.h>
+#include <ImfPartType.h>
+#include <ImfRgbaFile.h>
+#include <ImfTiledInputPart.h>
+#include <ImfTiledOutputFile.h>
+#include <ImfVersion.h>
+#include <Iex.h>
 
 namespace ibl_bake {
 namespace {
@@ -239,72 +246,383 @@ void check_hdr_data(std::span<const unsigned char> b, const hdr_layout& L, const
 }
 
 // ---- OpenEXR -----------------------------------------------------------------------------------
+//
+// Decoding is OpenEXR's (libopenexr-dev). Before OpenEXR sees a byte, scan_exr_headers walks
+// every part's header exactly as OpenEXR's Header::readFrom will (the same name-length limits,
+// the same number of bytes consumed per attribute), rejects what OpenEXR would misread or what
+// would make it allocate more than the limits allow (a preview image of 2^64 bytes, a string
+// vector entry of 2 GB, a chunk table larger than the file), and checks the `type` attribute
+// against the file's layout. OpenEXR then parses the same bytes to the same values.
 
-/// Copies tinyexr's error string into a std::string and frees it.
-std::string take_exr_error(const char*& err, int code) {
-    std::string s = err ? std::string(err) : std::string("tinyexr error code ") + std::to_string(code);
-    if (err) FreeEXRErrorMessage(err);
-    err = nullptr;
-    while (!s.empty() && (s.back() == '\n' || s.back() == ' ')) s.pop_back();
-    return printable(s, 200);
-}
+constexpr unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
+constexpr std::uint32_t exr_tiled_flag = 0x200, exr_long_names_flag = 0x400, exr_non_image_flag = 0x800,
+                        exr_multipart_flag = 0x1000;
 
-struct exr_header_owner {
-    EXRHeader h;
-    bool parsed = false;
-    exr_header_owner() { InitEXRHeader(&h); }
-    ~exr_header_owner() {
-        if (parsed) FreeEXRHeader(&h);
-    }
-    exr_header_owner(const exr_header_owner&) = delete;
-    exr_header_owner& operator=(const exr_header_owner&) = delete;
+constexpr const char* exr_compression_names[] = {"NONE", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB"};
+/// Scanlines per chunk of each compression (OpenEXR's numLinesInBuffer).
+constexpr int exr_lines_per_chunk[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+
+struct exr_box {
+    std::int64_t x0 = 0, y0 = 0, x1 = -1, y1 = -1;
+    std::int64_t width() const { return x1 - x0 + 1; }
+    std::int64_t height() const { return y1 - y0 + 1; }
 };
 
-struct exr_image_owner {
-    EXRImage img;
-    bool loaded = false;
-    exr_image_owner() { InitEXRImage(&img); }
-    ~exr_image_owner() {
-        if (loaded) FreeEXRImage(&img);
-    }
-    exr_image_owner(const exr_image_owner&) = delete;
-    exr_image_owner& operator=(const exr_image_owner&) = delete;
+/// What scan_exr_headers learnt about one part.
+struct exr_part_scan {
+    std::string name, type;
+    bool has_name = false, has_type = false, has_data = false, has_display = false, has_tiles = false,
+         has_chunk_count = false, has_channels = false;
+    exr_box data, display;
+    int compression = -1;
+    std::uint32_t tile_x = 0, tile_y = 0;
+    int level_mode = 0, rounding_mode = 0;
+    std::int64_t chunk_count = 0;
+    std::uint64_t bytes_per_pixel = 0; ///< all channels at full resolution (an upper bound)
+    bool tiled = false, deep = false;
 };
 
-/// The value of the single-part header's "compression" attribute, found by walking the attribute
-/// list (name\0 type\0 int32 size, value) with bounds checks; -1 if absent or unreadable (tinyexr
-/// then reports the problem). Used to name compressions tinyexr cannot decode before it says
-/// "Unknown compression type".
-int exr_compression_attribute(std::span<const unsigned char> b) {
-    std::size_t p = 8; // magic + version
-    const auto cstring = [&](std::string_view& out) {
-        const auto* begin = b.data() + p;
-        const auto* end = b.data() + b.size();
-        const auto* nul = std::find(begin, std::min(end, begin + 256), static_cast<unsigned char>(0));
-        if (nul == end || nul == begin + 256) return false;
-        out = std::string_view(reinterpret_cast<const char*>(begin), std::size_t(nul - begin));
-        p = std::size_t(nul - b.data()) + 1;
-        return true;
-    };
-    while (p < b.size() && b[p] != 0) {
-        std::string_view attr_name, attr_type;
-        if (!cstring(attr_name) || !cstring(attr_type) || b.size() - p < 4) return -1;
-        const std::uint32_t size = std::uint32_t(b[p]) | (std::uint32_t(b[p + 1]) << 8) | (std::uint32_t(b[p + 2]) << 16) |
-                                   (std::uint32_t(b[p + 3]) << 24);
+/// Bounds-checked little-endian reads; every failure is a truncated or corrupt header.
+struct exr_reader {
+    std::span<const unsigned char> b;
+    std::size_t p = 0;
+    const std::string& file;
+
+    [[noreturn]] void fail(const std::string& what) const { throw image_error(file, "corrupt OpenEXR header (" + what + ")"); }
+    [[noreturn]] void truncated(const std::string& what) const {
+        throw image_error(file, "truncated OpenEXR file (header ends inside " + what + ")");
+    }
+    void need(std::size_t n, const std::string& what) const {
+        if (b.size() - p < n) truncated(what);
+    }
+    std::uint8_t u8(const std::string& what) {
+        need(1, what);
+        return b[p++];
+    }
+    std::uint32_t u32(const std::string& what) {
+        need(4, what);
+        const std::uint32_t v = std::uint32_t(b[p]) | (std::uint32_t(b[p + 1]) << 8) | (std::uint32_t(b[p + 2]) << 16) |
+                                (std::uint32_t(b[p + 3]) << 24);
         p += 4;
-        if (size > b.size() - p) return -1;
-        if (attr_name == "compression" && attr_type == "compression" && size == 1) return b[p];
-        p += size;
+        return v;
     }
+    std::int32_t i32(const std::string& what) { return static_cast<std::int32_t>(u32(what)); }
+    /// A NUL-terminated name of at most max_len characters (OpenEXR's Xdr::read of a name reads
+    /// max_len + 1 bytes at most and stops there, unterminated: such a name is refused here).
+    std::string_view name(std::size_t max_len, const std::string& what) {
+        const auto* begin = b.data() + p;
+        const std::size_t avail = b.size() - p;
+        const auto* end = begin + std::min(avail, max_len + 1);
+        const auto* nul = std::find(begin, end, static_cast<unsigned char>(0));
+        if (nul == end) {
+            if (avail <= max_len) truncated(what);
+            fail(what + " longer than " + std::to_string(max_len) + " characters");
+        }
+        p = std::size_t(nul - b.data()) + 1;
+        return {reinterpret_cast<const char*>(begin), std::size_t(nul - begin)};
+    }
+};
+
+/// Bytes that OpenEXR's reader of a fixed-size attribute type consumes whatever the declared size.
+int exr_fixed_attribute_size(std::string_view type) {
+    static constexpr std::pair<std::string_view, int> sizes[] = {
+        {"box2i", 16}, {"box2f", 16}, {"int", 4}, {"float", 4}, {"double", 8}, {"v2i", 8}, {"v2f", 8}, {"v2d", 16},
+        {"v3i", 12}, {"v3f", 12}, {"v3d", 24}, {"m33f", 36}, {"m33d", 72}, {"m44f", 64}, {"m44d", 128},
+        {"compression", 1}, {"lineOrder", 1}, {"envmap", 1}, {"deepImageState", 1}, {"tiledesc", 9},
+        {"chromaticities", 32}, {"rational", 8}, {"keycode", 28}, {"timecode", 8}};
+    for (const auto& [t, n] : sizes)
+        if (t == type) return n;
     return -1;
 }
 
-const char* exr_compression_name(int c) {
-    static constexpr const char* names[] = {"NONE", "RLE", "ZIPS", "ZIP", "PIZ", "PXR24", "B44", "B44A", "DWAA", "DWAB", "HTJ2K"};
-    return c >= 0 && c < int(std::size(names)) ? names[c] : "unknown";
+std::int64_t exr_level_size(std::int64_t size, int level, int rounding) {
+    const std::int64_t b = std::int64_t(1) << level;
+    std::int64_t s = size / b;
+    if (rounding == 1 && s * b < size) ++s;
+    return std::max<std::int64_t>(s, 1);
 }
 
-constexpr unsigned char exr_magic[4] = {0x76, 0x2f, 0x31, 0x01};
+int exr_round_log2(std::int64_t x, int rounding) {
+    int floor_log = 0;
+    while ((std::int64_t(1) << (floor_log + 1)) <= x) ++floor_log;
+    return (rounding == 1 && (std::int64_t(1) << floor_log) < x) ? floor_log + 1 : floor_log;
+}
+
+/// The number of chunks (entries of the offset table) of a part, as OpenEXR computes it.
+std::uint64_t exr_chunk_count(const exr_part_scan& P) {
+    const std::int64_t w = P.data.width(), h = P.data.height();
+    if (!P.tiled) {
+        const std::int64_t n = exr_lines_per_chunk[P.compression];
+        return std::uint64_t((h + n - 1) / n);
+    }
+    const auto tiles = [&](int lx, int ly) {
+        const std::int64_t lw = exr_level_size(w, lx, P.rounding_mode), lh = exr_level_size(h, ly, P.rounding_mode);
+        return std::uint64_t((lw + P.tile_x - 1) / P.tile_x) * std::uint64_t((lh + P.tile_y - 1) / P.tile_y);
+    };
+    std::uint64_t n = 0;
+    if (P.level_mode == 0) {
+        n = tiles(0, 0);
+    } else if (P.level_mode == 1) {
+        const int levels = exr_round_log2(std::max(w, h), P.rounding_mode) + 1;
+        for (int l = 0; l < levels; ++l) n += tiles(l, l);
+    } else {
+        const int nx = exr_round_log2(w, P.rounding_mode) + 1, ny = exr_round_log2(h, P.rounding_mode) + 1;
+        for (int lx = 0; lx < nx; ++lx)
+            for (int ly = 0; ly < ny; ++ly) n += tiles(lx, ly);
+    }
+    return n;
+}
+
+std::string exr_part_label(const exr_part_scan& P, std::size_t index) {
+    return "part " + std::to_string(index) + (P.has_name ? " '" + printable(P.name, 64) + "'" : std::string());
+}
+
+/// Walks the headers of every part; throws image_error for anything OpenEXR would misread, any
+/// size beyond the limits and any layout the reader does not support.
+std::vector<exr_part_scan> scan_exr_headers(std::span<const unsigned char> b, const std::string& file,
+                                            const read_options& o) {
+    exr_reader r{b, 4, file};
+    const std::uint32_t version = r.u32("the version field");
+    if ((version & 0xff) != 2)
+        throw image_error(file, "unsupported OpenEXR file format version " + std::to_string(version & 0xff) + " (only 2)");
+    const std::uint32_t flags = version & ~0xffu;
+    if (flags & ~(exr_tiled_flag | exr_long_names_flag | exr_non_image_flag | exr_multipart_flag))
+        throw image_error(file, "unsupported OpenEXR version flags 0x" + [&] {
+            char buf[16];
+            std::snprintf(buf, sizeof buf, "%x", unsigned(flags));
+            return std::string(buf);
+        }());
+    const bool multipart = flags & exr_multipart_flag;
+    if (!multipart && (flags & exr_non_image_flag)) throw image_error(file, "deep OpenEXR images are not supported");
+    const std::size_t max_name = (flags & exr_long_names_flag) ? 255 : 31;
+
+    std::vector<exr_part_scan> parts;
+    for (;;) {
+        if (multipart && r.u8("the part list") == 0) break; // the empty header ending the list
+        if (multipart) --r.p;
+        if (parts.size() >= 4096) throw image_error(file, "corrupt OpenEXR header (more than 4096 parts)");
+        exr_part_scan P;
+        const std::string where = "the header of part " + std::to_string(parts.size());
+        for (;;) {
+            const std::string_view attr = r.name(max_name, where);
+            if (attr.empty()) break;
+            const std::string what = "attribute '" + printable(attr) + "'";
+            const std::string_view type = r.name(max_name, "the type name of " + what);
+            const std::int32_t size = r.i32(what);
+            if (size < 0) r.fail(what + " has a negative size");
+            r.need(std::size_t(size), what);
+            const std::span<const unsigned char> v = b.subspan(r.p, std::size_t(size));
+            const int fixed = exr_fixed_attribute_size(type);
+            if (fixed >= 0 && size != fixed)
+                r.fail(what + " of type " + printable(type) + " has size " + std::to_string(size) + ", not " +
+                       std::to_string(fixed));
+            exr_reader vr{v, 0, file};
+            const auto typed = [&](std::string_view want) {
+                if (type != want) r.fail(what + " has type '" + printable(type) + "', not " + std::string(want));
+            };
+            if (type == "preview") { // width, height, 4 w h bytes: OpenEXR allocates from the two fields
+                if (size < 8) r.fail(what + " too short");
+                const std::uint64_t pw = vr.u32(what), ph = vr.u32(what);
+                if (8 + 4 * pw * ph != std::uint64_t(size) || pw > 65536 || ph > 65536)
+                    r.fail(what + " declares a " + std::to_string(pw) + " x " + std::to_string(ph) + " preview in " +
+                           std::to_string(size) + " bytes");
+            } else if (type == "stringvector") { // (int32 length, characters)*, exactly `size` bytes
+                while (vr.p < v.size()) {
+                    const std::int32_t n = vr.i32(what);
+                    if (n < 0 || std::size_t(n) > v.size() - vr.p) r.fail(what + " has an entry beyond its size");
+                    vr.p += std::size_t(n);
+                }
+            } else if (type == "floatvector") {
+                if (size % 4 != 0) r.fail(what + " has a size that is not a multiple of 4");
+            } else if (type == "chlist") { // (name, int32 type, u8 linear, 3 reserved, int32 xs, int32 ys)*, ""
+                std::size_t count = 0;
+                for (;;) {
+                    const std::string_view ch = vr.name(max_name, what);
+                    if (ch.empty()) break;
+                    const std::int32_t pt = vr.i32(what);
+                    vr.need(4, what);
+                    vr.p += 4;
+                    (void)vr.i32(what);
+                    (void)vr.i32(what);
+                    if (pt < 0 || pt > 2) r.fail("channel '" + printable(ch) + "' has pixel type " + std::to_string(pt));
+                    P.bytes_per_pixel += pt == 1 ? 2 : 4; // HALF : UINT, FLOAT
+                    ++count;
+                }
+                if (vr.p != v.size()) r.fail(what + " does not end where its size says");
+                if (attr == "channels") {
+                    if (count == 0) r.fail("no channels");
+                    P.has_channels = true;
+                }
+            }
+            const auto box = [&] {
+                exr_box x;
+                x.x0 = vr.i32(what);
+                x.y0 = vr.i32(what);
+                x.x1 = vr.i32(what);
+                x.y1 = vr.i32(what);
+                return x;
+            };
+            if (attr == "dataWindow") {
+                typed("box2i");
+                P.data = box();
+                P.has_data = true;
+            } else if (attr == "displayWindow") {
+                typed("box2i");
+                P.display = box();
+                P.has_display = true;
+            } else if (attr == "compression") {
+                typed("compression");
+                P.compression = v[0];
+                if (P.compression >= int(std::size(exr_compression_names)))
+                    throw image_error(file, "unsupported OpenEXR compression (value " + std::to_string(P.compression) + ")");
+            } else if (attr == "tiles") {
+                typed("tiledesc");
+                P.tile_x = vr.u32(what);
+                P.tile_y = vr.u32(what);
+                const std::uint8_t mode = vr.u8(what);
+                P.level_mode = mode & 0x0f;
+                P.rounding_mode = mode >> 4;
+                if (P.level_mode > 2 || P.rounding_mode > 1) r.fail("unknown tile level mode " + std::to_string(mode));
+                P.has_tiles = true;
+            } else if (attr == "chunkCount") {
+                typed("int");
+                P.chunk_count = vr.i32(what);
+                P.has_chunk_count = true;
+            } else if (attr == "name") {
+                typed("string");
+                P.name.assign(reinterpret_cast<const char*>(v.data()), v.size());
+                P.has_name = true;
+            } else if (attr == "type") {
+                typed("string");
+                P.type.assign(reinterpret_cast<const char*>(v.data()), v.size());
+                P.has_type = true;
+            } else if (attr == "channels") {
+                typed("chlist");
+            }
+            r.p += std::size_t(size);
+        }
+        const std::string label = exr_part_label(P, parts.size());
+        const auto bad = [&](const std::string& what) -> image_error {
+            return image_error(file, "corrupt OpenEXR header (" + label + ": " + what + ")");
+        };
+        if (!P.has_channels) throw bad("no channels attribute");
+        if (P.compression < 0) throw bad("no compression attribute");
+        if (!P.has_data || !P.has_display) throw bad("no data or display window");
+        if (multipart) {
+            // Every part of a multi-part file names its type; the version's tiled flag is unused.
+            if (!P.has_type) throw bad("no type attribute");
+            if (!P.has_name) throw bad("no name attribute");
+            if (!P.has_chunk_count) throw bad("no chunkCount attribute");
+            if (P.type == "scanlineimage" || P.type == "tiledimage") {
+                P.tiled = P.type == "tiledimage";
+            } else if (P.type == "deepscanline" || P.type == "deeptile") {
+                P.tiled = P.type == "deeptile";
+                P.deep = true;
+            } else {
+                throw image_error(file, "unsupported OpenEXR part type '" + printable(P.type) + "' (" + label + ")");
+            }
+        } else {
+            // A single-part file's layout is its version's tiled flag; a `type` attribute must agree.
+            P.tiled = flags & exr_tiled_flag;
+            const char* expected = P.tiled ? "tiledimage" : "scanlineimage";
+            if (P.has_type && P.type != expected)
+                throw image_error(file, "OpenEXR type attribute '" + printable(P.type) + "' contradicts the file's " +
+                                            (P.tiled ? "tiled" : "scanline") + " layout (expected '" + expected + "')");
+        }
+        const auto dims = [](const exr_box& x, std::int64_t& w, std::int64_t& h) {
+            w = std::clamp<std::int64_t>(x.width(), -1, INT_MAX);
+            h = std::clamp<std::int64_t>(x.height(), -1, INT_MAX);
+        };
+        std::int64_t w = 0, h = 0, dw = 0, dh = 0;
+        dims(P.display, dw, dh);
+        check_dimensions(int(dw), int(dh), o, file, ("OpenEXR display window of " + label).c_str());
+        dims(P.data, w, h);
+        check_dimensions(int(w), int(h), o, file, ("OpenEXR data window of " + label).c_str());
+        if (P.tiled) {
+            if (!P.has_tiles) throw bad("tiled, but no tiles attribute");
+            if (P.tile_x < 1 || P.tile_y < 1 || P.tile_x > std::uint32_t(o.max_dimension) ||
+                P.tile_y > std::uint32_t(o.max_dimension))
+                throw bad("tile size " + std::to_string(P.tile_x) + " x " + std::to_string(P.tile_y) +
+                          " outside [1, " + std::to_string(o.max_dimension) + "]");
+        }
+        if (!P.deep) {
+            // OpenEXR allocates the decoded pixels of a chunk (a block of scanlines or a tile) up
+            // front, and the reader the whole data window: both must fit max_decoded_bytes.
+            const std::uint64_t chunk_pixels =
+                P.tiled ? std::uint64_t(P.tile_x) * P.tile_y : std::uint64_t(w) * std::uint64_t(exr_lines_per_chunk[P.compression]);
+            const std::uint64_t limit = o.max_decoded_bytes;
+            for (const std::uint64_t pixels : {std::uint64_t(w) * std::uint64_t(h), chunk_pixels})
+                if (P.bytes_per_pixel > limit || pixels > limit / P.bytes_per_pixel)
+                    throw image_error(file, "OpenEXR " + label + ": " + std::to_string(pixels) + " pixels of " +
+                                                std::to_string(P.bytes_per_pixel) +
+                                                " bytes exceed the decoding limit of " + std::to_string(limit) + " bytes");
+        }
+        const std::uint64_t chunks = exr_chunk_count(P);
+        if (P.has_chunk_count && (P.chunk_count < 0 || std::uint64_t(P.chunk_count) != chunks))
+            throw bad("chunkCount " + std::to_string(P.chunk_count) + ", but the layout has " + std::to_string(chunks) +
+                      " chunks");
+        P.chunk_count = std::int64_t(chunks);
+        parts.push_back(std::move(P));
+        if (!multipart) break;
+    }
+    if (parts.empty()) throw image_error(file, "corrupt OpenEXR header (a multi-part file without parts)");
+    // The chunk offset tables (8 bytes a chunk) follow the headers; OpenEXR allocates them from the
+    // counts, so they must be in the file.
+    std::uint64_t chunks = 0;
+    for (const exr_part_scan& P : parts) chunks += std::uint64_t(P.chunk_count);
+    if (chunks > (b.size() - r.p) / 8)
+        throw image_error(file, "truncated OpenEXR file (" + std::to_string(chunks) + " chunks need an offset table of " +
+                                    std::to_string(8 * chunks) + " bytes; " + std::to_string(b.size() - r.p) +
+                                    " bytes follow the header)");
+    return parts;
+}
+
+/// An Imf::IStream over bytes in memory. Reading past the end throws (as OpenEXR expects) and is
+/// remembered, so that the error can say "truncated".
+class span_istream final : public Imf::IStream {
+public:
+    span_istream(std::span<const unsigned char> b, const std::string& file) : Imf::IStream(file.c_str()), b_(b) {}
+    bool read(char c[], int n) override {
+        if (n < 0 || pos_ > b_.size() || std::size_t(n) > b_.size() - pos_) {
+            past_end_ = true;
+            throw Iex::InputExc("unexpected end of file");
+        }
+        if (n > 0) std::memcpy(c, b_.data() + pos_, std::size_t(n));
+        pos_ += std::size_t(n);
+        return pos_ < b_.size();
+    }
+    std::uint64_t tellg() override { return pos_; }
+    void seekg(std::uint64_t pos) override { pos_ = pos > b_.size() ? b_.size() + 1 : std::size_t(pos); }
+    bool past_end() const { return past_end_; }
+
+private:
+    std::span<const unsigned char> b_;
+    std::size_t pos_ = 0;
+    bool past_end_ = false;
+};
+
+/// An Imf::OStream into a byte vector.
+class vector_ostream final : public Imf::OStream {
+public:
+    explicit vector_ostream(std::vector<unsigned char>& out) : Imf::OStream("<memory>"), out_(out) {}
+    void write(const char c[], int n) override {
+        if (n <= 0) return;
+        if (out_.size() < pos_ + std::size_t(n)) out_.resize(pos_ + std::size_t(n));
+        std::memcpy(out_.data() + pos_, c, std::size_t(n));
+        pos_ += std::size_t(n);
+    }
+    std::uint64_t tellp() override { return pos_; }
+    void seekp(std::uint64_t pos) override { pos_ = std::size_t(pos); }
+
+private:
+    std::vector<unsigned char>& out_;
+    std::size_t pos_ = 0;
+};
+
+/// OpenEXR decodes in the calling thread: every OpenEXR object gets numThreads = 0, and the
+/// global thread count (Imf::setGlobalThreadCount) is left alone.
+constexpr int exr_threads = 0;
+
 constexpr std::string_view hdr_magic1 = "#?RADIANCE\n";
 constexpr std::string_view hdr_magic2 = "#?RGBE\n";
 
@@ -401,92 +719,182 @@ image_rgb32f read_hdr_memory(std::span<const unsigned char> bytes, const std::st
     return img;
 }
 
+namespace {
+
+/// Reads the selected part's display window as RGB floats (see image_io.hpp for the rules).
+image_rgb32f decode_exr_part(std::span<const unsigned char> bytes, const std::string& name, const read_options& o,
+                             span_istream& in, std::string& detail) {
+    Imf::MultiPartInputFile file(in, exr_threads, true);
+    const int parts = file.parts();
+    const auto has = [&](int i, const char* ch) { return file.header(i).channels().findChannel(ch) != nullptr; };
+    const auto is_image = [&](int i) {
+        const Imf::Header& h = file.header(i);
+        return !h.hasType() || h.type() == Imf::SCANLINEIMAGE || h.type() == Imf::TILEDIMAGE;
+    };
+    const auto part_names = [&] {
+        std::string s;
+        for (int i = 0; i < parts; ++i)
+            s += (i ? ", " : "") + (file.header(i).hasName() ? "'" + printable(file.header(i).name(), 64) + "'"
+                                                              : "#" + std::to_string(i));
+        return s;
+    };
+    int chosen = -1;
+    if (!o.part.empty()) {
+        for (int i = 0; i < parts && chosen < 0; ++i)
+            if (file.header(i).hasName() && file.header(i).name() == o.part) chosen = i;
+        if (chosen < 0)
+            throw image_error(name, "OpenEXR has no part named '" + printable(o.part, 64) + "' (parts: " + part_names() + ")");
+        if (!is_image(chosen))
+            throw image_error(name, "OpenEXR part '" + printable(o.part, 64) + "' holds deep data (not supported)");
+    } else {
+        for (int i = 0; i < parts && chosen < 0; ++i)
+            if (is_image(i) && has(i, "R") && has(i, "G") && has(i, "B")) chosen = i;
+        for (int i = 0; i < parts && chosen < 0; ++i)
+            if (is_image(i) && has(i, "Y")) chosen = i;
+        if (chosen < 0) {
+            std::string found;
+            for (auto it = file.header(0).channels().begin(); it != file.header(0).channels().end(); ++it)
+                found += (found.empty() ? "" : ", ") + printable(it.name(), 32);
+            throw image_error(name, parts == 1 ? "OpenEXR has no R, G, B or Y channels (channels: " + found + ")"
+                                               : "OpenEXR has no part with R, G, B or Y channels (parts: " + part_names() + ")");
+        }
+    }
+    const Imf::Header& H = file.header(chosen);
+    const Imf::ChannelList& channels = H.channels();
+    const bool rgb = has(chosen, "R") && has(chosen, "G") && has(chosen, "B");
+    const bool luma = !rgb && has(chosen, "Y");
+    const bool chroma = luma && has(chosen, "RY") && has(chosen, "BY");
+    if (!rgb && !luma) {
+        std::string found;
+        for (auto it = channels.begin(); it != channels.end(); ++it) found += (found.empty() ? "" : ", ") + printable(it.name(), 32);
+        throw image_error(name, "OpenEXR part '" + printable(o.part, 64) + "' has no R, G, B or Y channels (channels: " +
+                                    found + ")");
+    }
+    const auto full_resolution = [&](const char* ch) {
+        const Imf::Channel& c = *channels.findChannel(ch);
+        if (c.xSampling != 1 || c.ySampling != 1)
+            throw image_error(name, std::string("subsampled OpenEXR channel '") + ch + "' not supported");
+    };
+    if (rgb) {
+        full_resolution("R");
+        full_resolution("G");
+        full_resolution("B");
+    } else {
+        full_resolution("Y");
+    }
+    const Imath::Box2i dwin = H.dataWindow(), disp = H.displayWindow();
+    const int dw = dwin.max.x - dwin.min.x + 1, dh = dwin.max.y - dwin.min.y + 1;
+    const int w = disp.max.x - disp.min.x + 1, h = disp.max.y - disp.min.y + 1;
+    check_dimensions(w, h, o, name, "OpenEXR display window"); // the scan checked these already
+    check_dimensions(dw, dh, o, name, "OpenEXR data window");
+    const bool tiled = H.hasType() ? Imf::isTiled(H.type()) : Imf::isTiled(file.version());
+    detail = (parts > 1 ? "part " + std::to_string(chosen) +
+                              (H.hasName() ? " '" + printable(H.name(), 64) + "'" : std::string()) + " of " +
+                              std::to_string(parts) + ", "
+                        : std::string()) +
+             exr_compression_names[std::min<int>(H.compression(), int(std::size(exr_compression_names)) - 1)] +
+             (tiled ? ", tiled" : ", scanline") + (rgb ? ", RGB" : chroma ? ", Y/RY/BY" : ", Y");
+
+    // The data window's pixels, RGB interleaved.
+    const std::size_t dn = std::size_t(dw) * std::size_t(dh);
+    std::vector<float> px(3 * dn, 0.0f);
+    if (!chroma) {
+        Imf::InputPart part(file, chosen);
+        Imf::FrameBuffer fb;
+        if (rgb) {
+            for (int k = 0; k < 3; ++k)
+                fb.insert(k == 0 ? "R" : k == 1 ? "G" : "B",
+                          Imf::Slice::Make(Imf::FLOAT, px.data() + k, dwin, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(dw)));
+        } else {
+            fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, px.data(), dwin, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(dw)));
+        }
+        part.setFrameBuffer(fb);
+        part.readPixels(dwin.min.y, dwin.max.y);
+        if (!rgb)
+            for (std::size_t t = 0; t < dn; ++t) px[3 * t + 1] = px[3 * t + 2] = px[3 * t];
+    } else {
+        // Luminance/chroma: OpenEXR's RgbaInputFile does the conversion (chroma reconstruction and
+        // YCA -> RGB with the file's chromaticities). It reads the first part of a file, so another
+        // part is first copied, still compressed, into a single-part file in memory.
+        std::vector<unsigned char> single;
+        std::span<const unsigned char> src = bytes;
+        if (chosen != 0 || parts > 1) {
+            Imf::Header sh = H;
+            vector_ostream os(single);
+            if (tiled) {
+                Imf::TiledInputPart tin(file, chosen);
+                Imf::TiledOutputFile out(os, sh, exr_threads);
+                out.copyPixels(tin);
+            } else {
+                Imf::InputPart pin(file, chosen);
+                Imf::OutputFile out(os, sh, exr_threads);
+                out.copyPixels(pin);
+            }
+            src = single;
+        }
+        span_istream in2(src, name);
+        Imf::RgbaInputFile rin(in2, exr_threads);
+        std::vector<Imf::Rgba> rgba(dn);
+        // Base address of pixel (0, 0) in the data window's coordinates, computed on integers
+        // (the pointer itself may lie outside the buffer; OpenEXR only adds offsets back).
+        const std::intptr_t base = reinterpret_cast<std::intptr_t>(rgba.data()) -
+                                   (std::intptr_t(dwin.min.x) + std::intptr_t(dwin.min.y) * std::intptr_t(dw)) *
+                                       std::intptr_t(sizeof(Imf::Rgba));
+        rin.setFrameBuffer(reinterpret_cast<Imf::Rgba*>(base), 1, std::size_t(dw));
+        rin.readPixels(dwin.min.y, dwin.max.y);
+        for (std::size_t t = 0; t < dn; ++t) {
+            px[3 * t] = float(rgba[t].r);
+            px[3 * t + 1] = float(rgba[t].g);
+            px[3 * t + 2] = float(rgba[t].b);
+        }
+    }
+
+    // The display window is the image: its pixels outside the data window are 0, data outside
+    // it is cropped.
+    if (dwin == disp) {
+        image_rgb32f img;
+        img.width = w;
+        img.height = h;
+        img.rgb = std::move(px);
+        return img;
+    }
+    image_rgb32f img(w, h);
+    const int x0 = std::max(dwin.min.x, disp.min.x), x1 = std::min(dwin.max.x, disp.max.x);
+    const int y0 = std::max(dwin.min.y, disp.min.y), y1 = std::min(dwin.max.y, disp.max.y);
+    for (int y = y0; y <= y1; ++y)
+        for (int x = x0; x <= x1; ++x) {
+            const float* s = px.data() + 3 * (std::size_t(y - dwin.min.y) * std::size_t(dw) + std::size_t(x - dwin.min.x));
+            std::copy(s, s + 3, img.texel(x - disp.min.x, y - disp.min.y));
+        }
+    return img;
+}
+
+} // namespace
+
 image_rgb32f read_exr_memory(std::span<const unsigned char> bytes, const std::string& name, const read_options& o,
                              read_report* report) {
     if (bytes.empty()) throw image_error(name, "empty file");
-    EXRVersion version;
-    int rc = ParseEXRVersionFromMemory(&version, bytes.data(), bytes.size());
-    if (rc != TINYEXR_SUCCESS)
-        throw image_error(name, bytes.size() < 8 ? "truncated OpenEXR file (no version header)"
-                                                 : "not a valid OpenEXR file (bad version header)");
-    if (version.multipart) throw image_error(name, "multi-part OpenEXR not supported");
-    if (version.non_image) throw image_error(name, "deep OpenEXR not supported");
-    if (version.tiled) throw image_error(name, "tiled OpenEXR not supported (scanline images only)");
-
-    const int compression = exr_compression_attribute(bytes);
-    if (compression > TINYEXR_COMPRESSIONTYPE_PIZ)
-        throw image_error(name, std::string("OpenEXR compression ") + exr_compression_name(compression) + " (" +
-                                    std::to_string(compression) +
-                                    ") is not supported by tinyexr 1.0.1, which decodes NONE, RLE, ZIPS, ZIP and PIZ; "
-                                    "re-save the file with one of those (e.g. ZIP)");
-
-    exr_header_owner header;
-    const char* err = nullptr;
-    rc = ParseEXRHeaderFromMemory(&header.h, &version, bytes.data(), bytes.size(), &err);
-    header.parsed = true;
-    if (rc != TINYEXR_SUCCESS) throw image_error(name, "corrupt OpenEXR header (" + take_exr_error(err, rc) + ")");
-    EXRHeader& H = header.h;
-    if (H.tiled) throw image_error(name, "tiled OpenEXR not supported (scanline images only)");
-    const long long dw = static_cast<long long>(H.data_window.max_x) - H.data_window.min_x + 1;
-    const long long dh = static_cast<long long>(H.data_window.max_y) - H.data_window.min_y + 1;
-    check_dimensions(int(std::clamp<long long>(dw, -1, INT_MAX)), int(std::clamp<long long>(dh, -1, INT_MAX)), o, name,
-                     "OpenEXR");
-    // tinyexr sizes its offset table from the optional chunkCount attribute before checking it
-    // (a 3 KB file asked for 6.6 GB; found by scripts/fuzz.sh, regression input
-    // tools/ibl-bake/tests/data/fuzz-oom-exr-chunkcount). A scanline image has at most one
-    // chunk per row.
-    if (H.chunk_count < 0 || H.chunk_count > dh)
-        throw image_error(name, "corrupt OpenEXR header (chunkCount " + std::to_string(H.chunk_count) + " for " +
-                                    std::to_string(dh) + " scanlines)");
-
-    int idx[3] = {-1, -1, -1};
-    const char* wanted[3] = {"R", "G", "B"};
-    std::string found;
-    for (int c = 0; c < H.num_channels; ++c) {
-        const EXRChannelInfo& ch = H.channels[c];
-        const std::string_view ch_name(ch.name, strnlen(ch.name, sizeof ch.name));
-        found += (found.empty() ? "" : ", ") + printable(ch_name, 32);
-        for (int k = 0; k < 3; ++k)
-            if (ch_name == wanted[k]) idx[k] = c;
-    }
-    for (int k = 0; k < 3; ++k) {
-        if (idx[k] < 0)
-            throw image_error(name, std::string("OpenEXR has no '") + wanted[k] + "' channel (channels: " + found + ")");
-        const EXRChannelInfo& ch = H.channels[idx[k]];
-        if (ch.x_sampling != 1 || ch.y_sampling != 1)
-            throw image_error(name, std::string("subsampled OpenEXR channel '") + wanted[k] + "' not supported");
-        if (H.pixel_types[idx[k]] == TINYEXR_PIXELTYPE_UINT)
-            throw image_error(name, std::string("OpenEXR channel '") + wanted[k] + "' is UINT, not HALF or FLOAT");
-    }
-    for (int c = 0; c < H.num_channels; ++c)
-        if (H.pixel_types[c] == TINYEXR_PIXELTYPE_HALF) H.requested_pixel_types[c] = TINYEXR_PIXELTYPE_FLOAT;
-
-    exr_image_owner image;
-    // tinyexr 1.0.1 frees a failed image itself with FreeEXRImage, which frees the channel buffers
-    // only for i < image.num_channels, and sets num_channels only after a successful decode: the
-    // buffers of a chunk that fails to decode leaked (found by fuzzing, regression input
-    // tests/data/fuzz-leak-tinyexr-decodechunk). Setting num_channels first lets that cleanup free
-    // them; on failure the image must not be freed again (tinyexr leaves `images` dangling).
-    image.img.num_channels = H.num_channels;
-    rc = LoadEXRImageFromMemory(&image.img, &H, bytes.data(), bytes.size(), &err);
-    image.loaded = rc == TINYEXR_SUCCESS;
-    if (rc != TINYEXR_SUCCESS) {
-        std::string msg = take_exr_error(err, rc);
-        throw image_error(name, "corrupt or truncated OpenEXR data (" + msg + ")");
-    }
-    const EXRImage& I = image.img;
-    if (!I.images || I.width != dw || I.height != dh || I.num_channels != H.num_channels)
-        throw image_error(name, "OpenEXR decoder returned an unexpected image (" + std::to_string(I.width) + " x " +
-                                    std::to_string(I.height) + ")");
-    image_rgb32f img(I.width, I.height);
-    const std::size_t n = std::size_t(I.width) * std::size_t(I.height);
-    for (int k = 0; k < 3; ++k) {
-        const auto* src = reinterpret_cast<const float*>(I.images[idx[k]]);
-        if (!src) throw image_error(name, "OpenEXR decoder returned no data for a channel");
-        for (std::size_t t = 0; t < n; ++t) img.rgb[3 * t + std::size_t(k)] = src[t];
-    }
+    if (bytes.size() < 8) throw image_error(name, "truncated OpenEXR file (no version header)");
+    if (std::memcmp(bytes.data(), exr_magic, 4) != 0) throw image_error(name, "not an OpenEXR file (bad magic number)");
+    (void)scan_exr_headers(bytes, name, o);
+    span_istream in(bytes, name);
     read_report r;
     r.format = "OpenEXR";
+    image_rgb32f img;
+    try {
+        img = decode_exr_part(bytes, name, o, in, r.detail);
+    } catch (const image_error&) {
+        throw;
+    } catch (const std::bad_alloc&) {
+        throw image_error(name, "out of memory decoding OpenEXR");
+    } catch (const std::exception& e) {
+        // OpenEXR's messages (Iex::BaseExc) often start with the stream's name: keep what follows.
+        std::string msg = e.what();
+        if (msg.starts_with(name)) msg.erase(0, name.size());
+        while (!msg.empty() && (msg.front() == ':' || msg.front() == ' ' || msg.front() == '.')) msg.erase(0, 1);
+        throw image_error(name, std::string(in.past_end() ? "truncated OpenEXR file" : "corrupt OpenEXR data") +
+                                    " (OpenEXR: " + printable(msg, 200) + ")");
+    }
     apply_texel_policy(img, o, r, name);
     if (report) *report = r;
     return img;
@@ -555,47 +963,25 @@ float srgb_oetf(float x) noexcept {
 
 std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name) {
     check_image(image, name);
-    const std::size_t n = std::size_t(image.width) * std::size_t(image.height);
-    std::vector<float> planes[3]; // B, G, R
-    for (int k = 0; k < 3; ++k) {
-        planes[k].resize(n);
-        for (std::size_t t = 0; t < n; ++t) planes[k][t] = image.rgb[3 * t + std::size_t(2 - k)];
+    std::vector<unsigned char> out;
+    try {
+        Imf::Header header(image.width, image.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
+        vector_ostream os(out);
+        Imf::OutputFile file(os, header, exr_threads);
+        Imf::FrameBuffer fb;
+        // OpenEXR only reads through the slices of an output file.
+        char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgb.data()));
+        const std::size_t xs = 3 * sizeof(float), ys = xs * std::size_t(image.width);
+        fb.insert("R", Imf::Slice(Imf::FLOAT, base, xs, ys));
+        fb.insert("G", Imf::Slice(Imf::FLOAT, base + sizeof(float), xs, ys));
+        fb.insert("B", Imf::Slice(Imf::FLOAT, base + 2 * sizeof(float), xs, ys));
+        file.setFrameBuffer(fb);
+        file.writePixels(image.height);
+    } catch (const std::exception& e) {
+        throw image_error(name, std::string("OpenEXR encoding failed (") + printable(e.what(), 200) + ")");
     }
-    unsigned char* ptrs[3] = {reinterpret_cast<unsigned char*>(planes[0].data()),
-                              reinterpret_cast<unsigned char*>(planes[1].data()),
-                              reinterpret_cast<unsigned char*>(planes[2].data())};
-    EXRChannelInfo channels[3];
-    std::memset(channels, 0, sizeof channels);
-    const char* names[3] = {"B", "G", "R"};
-    int pixel_types[3], requested[3];
-    for (int k = 0; k < 3; ++k) {
-        std::strcpy(channels[k].name, names[k]);
-        channels[k].pixel_type = TINYEXR_PIXELTYPE_FLOAT;
-        channels[k].x_sampling = channels[k].y_sampling = 1;
-        pixel_types[k] = requested[k] = TINYEXR_PIXELTYPE_FLOAT;
-    }
-    EXRHeader header;
-    InitEXRHeader(&header);
-    header.num_channels = 3;
-    header.channels = channels;
-    header.pixel_types = pixel_types;
-    header.requested_pixel_types = requested;
-    header.compression_type = TINYEXR_COMPRESSIONTYPE_ZIP;
-    EXRImage img;
-    InitEXRImage(&img);
-    img.images = ptrs;
-    img.width = image.width;
-    img.height = image.height;
-    img.num_channels = 3;
-    unsigned char* mem = nullptr;
-    const char* err = nullptr;
-    const std::size_t size = SaveEXRImageToMemory(&img, &header, &mem, &err);
-    if (size == 0 || !mem) {
-        std::free(mem);
-        throw image_error(name, "OpenEXR encoding failed (" + take_exr_error(err, 0) + ")");
-    }
-    std::vector<unsigned char> out(mem, mem + size);
-    std::free(mem);
     return out;
 }
 

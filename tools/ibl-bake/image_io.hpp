@@ -1,8 +1,8 @@
 #pragma once
 // tools/ibl-bake/image_io.hpp — image input/output of the ibl-bake tool (host only).
 //
-// Reading: Radiance .hdr (RGBE, decoded by stb_image) and OpenEXR (scanline, single part,
-// decoded by tinyexr) into image_rgb32f: linear RGB, float32, interleaved, top row first.
+// Reading: Radiance .hdr (RGBE, decoded by stb_image) and OpenEXR (decoded by OpenEXR 3, see
+// below) into image_rgb32f: linear RGB, float32, interleaved, top row first.
 // The format is recognised from the first bytes, never from the file name:
 //   "v/1\x01" (0x76 0x2f 0x31 0x01)   OpenEXR
 //   "#?RADIANCE\n" or "#?RGBE\n"      Radiance HDR (stbi_is_hdr must agree)
@@ -14,12 +14,35 @@
 // empty file, truncated data, unsupported variant, absurd dimensions, corrupt data. The readers
 // never return a partially decoded image: a Radiance file is walked structurally before decoding
 // (stb_image itself reads zeros past the end of a truncated file, and loops forever on a
-// truncated run-length scanline), and tinyexr's return codes are checked, its error strings
-// copied into the message and freed.
+// truncated run-length scanline), and every exception of OpenEXR becomes an image_error whose
+// message quotes OpenEXR's ("truncated OpenEXR file" when it read past the end).
+//
+// OpenEXR input, what is read:
+//   * every compression of OpenEXR 3.1 (NONE, RLE, ZIPS, ZIP, PIZ, PXR24, B44, B44A, DWAA, DWAB),
+//     scanline and tiled parts; of a tiled part (mip- or ripmapped) only level 0 is read;
+//   * the part: read_options::part names it (the `name` attribute); by default the first part
+//     with channels R, G and B, else the first with Y. Deep parts are never read;
+//   * the channels, by their exact names: R, G, B (any other channel, A included, is ignored);
+//     else Y alone (grey: R = G = B = Y); else Y, RY, BY (luminance/chroma, converted to RGB by
+//     OpenEXR's RgbaInputFile with the file's chromaticities; its result is half precision).
+//     HALF, FLOAT and UINT channels are converted to float by OpenEXR (exact for HALF, for FLOAT
+//     and for UINT below 2^24); R, G, B and Y must not be subsampled;
+//   * the windows: the image is the display window. Its pixels outside the data window are 0;
+//     data outside the display window is cropped. (A lat-long map is its display window.)
+//   * threads: OpenEXR decodes in the calling thread (numThreads = 0 for every OpenEXR object;
+//     the global thread count, Imf::setGlobalThreadCount, is left alone).
+// Before OpenEXR parses anything, the headers of all parts are walked with bounds checks
+// (image_io.cpp, scan_exr_headers): attribute sizes that OpenEXR would misread, a `type`
+// attribute that contradicts the file's layout (e.g. "deepscanline" in a scanline file), chunk
+// offset tables larger than the file, and sizes beyond the limits below are refused there.
 //
 // Limits (read_options): width and height in [1, max_dimension] (16384) and width * height
 // <= max_pixels (16384 * 8192: a 16k lat-long map, 1.6 GB as float RGB). They are checked from
-// the header, before any pixel memory is allocated.
+// the header, before any pixel memory is allocated. For OpenEXR they apply to the display and
+// the data window of every part (OpenEXR sizes each part's chunk table from its data window),
+// tile sizes must lie in [1, max_dimension], and max_decoded_bytes bounds both the decoded data
+// window of the part that is read (all its channels) and one decoded chunk (a block of
+// scanlines or a tile, which OpenEXR allocates whole).
 //
 // Texel policy, applied to every value after decoding (read_report counts what was changed):
 //   * finite negative values are clamped to 0. Radiance is non-negative; lossy EXR compression
@@ -85,6 +108,12 @@ struct read_options {
     int max_dimension = 16384;
     std::uint64_t max_pixels = std::uint64_t(16384) * 8192;
     nonfinite_policy nonfinite = nonfinite_policy::reject;
+    /// OpenEXR: decoded bytes of the part read and of one chunk (default: a max_pixels image
+    /// of four float channels, 2 GiB).
+    std::uint64_t max_decoded_bytes = std::uint64_t(16384) * 8192 * 16;
+    /// OpenEXR: the name of the part to read (its `name` attribute); empty = the first part with
+    /// R, G, B channels, else the first with Y. The tool's option: --part NAME.
+    std::string part;
 };
 
 /// What a reader found and changed.
@@ -95,6 +124,7 @@ struct read_report {
     float most_negative = 0.0f;        ///< the smallest value seen before clamping (0 if none)
     std::size_t nonfinite_values = 0;  ///< NaN / inf values (replaced by 0 under replace_with_zero)
     float max_value = 0.0f;            ///< largest channel value after the policy
+    std::string detail;                ///< OpenEXR: part, compression, layout, channels read
 };
 
 // ---- files -----------------------------------------------------------------------------------

@@ -28,6 +28,7 @@ void set_cube(source_env& src, const cube_faces& faces, const std::string& forma
 read_options input_read_options(const bake_options& opt) {
     read_options ro;
     ro.max_pixels = opt.max_input_pixels;
+    ro.part = opt.part;
     return ro;
 }
 
