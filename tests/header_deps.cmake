@@ -1,4 +1,4 @@
-# tests/header_deps.cmake — the include-dependency rules of the library's layers (issue 7: pay
+# tests/header_deps.cmake — the include-dependency rules of the library's layers (pay
 # only for what you include). For each umbrella / top-level header, the compiler's dependency
 # list (-M: every file the preprocessor opens) must contain only ibl headers under the allowed
 # prefixes. A layer that starts including a higher one (sh/ pulling in integrate/ prefilter code,

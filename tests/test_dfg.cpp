@@ -189,7 +189,7 @@ TEST_CASE_TEMPLATE("dfg: the exact table is within 1e-5 of the reference (16^2 t
             worst = std::fmax(worst, std::fmax(std::fabs(e[l] - b[l] - ref.x), std::fabs(b[l] - ref.y)));
         }
     }
-    CHECK(worst <= 1e-5); // the issue's target for tables (full-table figure: bench, 4.8e-6)
+    CHECK(worst <= 1e-5); // the target for tables (full-table figure: bench, 4.8e-6)
 }
 
 TEST_CASE("dfg: multiple-scattering compensation gives a white furnace") {

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/plan.hpp — the scene-driven bake plan (issue 7): which products, mip levels, resolutions,
+// ibl/plan.hpp — the scene-driven bake plan: which products, mip levels, resolutions,
 // SH bands, DFG table size and sample counts a scene needs, chosen from the scene's materials and
 // an error target with the library's measured error-vs-cost relations. Pure arithmetic on the
 // scene description: depends on core/ and integrate/roughness_mip.hpp only (no integrator code).

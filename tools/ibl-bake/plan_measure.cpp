@@ -1,5 +1,5 @@
 // tools/ibl-bake/plan_measure.cpp — the measurements behind the decision tables of
-// include/ibl/plan.hpp (issue 7). Run it after changing an integrator and update the tables.
+// include/ibl/plan.hpp. Run it after changing an integrator and update the tables.
 //
 //   1. DFG LUT: the largest bilinear-interpolation error of an exact N^2 table (clamp-to-edge, as
 //      a GPU samples it) against dfg_exact at off-grid points, N = 16 .. 256. The points are a

@@ -1,4 +1,4 @@
-// tools/ibl-bake/tests/test_scene.cpp — `ibl-bake --scene` end to end at tiny sizes (issue 7):
+// tools/ibl-bake/tests/test_scene.cpp — `ibl-bake --scene` end to end at tiny sizes:
 // the planned products and only those are written, the report says what was left out, bad scene
 // files fail with a clear message and leave DIR untouched, --compare-full runs.
 #include <doctest/doctest.h>
