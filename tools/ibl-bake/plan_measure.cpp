@@ -21,6 +21,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -86,21 +87,7 @@ sh_err sh_errors(const ibl::cubemap<float>& cube) {
         for (int y = 0; y < 16; ++y)
             for (int x = 0; x < 16; ++x) normals.push_back(ibl::cube_texel_direction<double>(f, x, y, 16));
     const int n = cube.size(0);
-    std::vector<dvec3> dir, rad;
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                dir.push_back(ibl::cube_texel_direction<double>(f, x, y, n));
-                rad.push_back(dvec3(cube.texel(f, x, y, 0)) * ibl::cube_texel_solid_angle<double>(x, y, n));
-            }
-    std::vector<dvec3> ref(normals.size());
-    ibl::thread_executor{}(normals.size(), [&](std::size_t b, std::size_t e) {
-        for (std::size_t i = b; i < e; ++i) {
-            dvec3 s(0);
-            for (std::size_t t = 0; t < dir.size(); ++t) s += rad[t] * std::max(0.0, glm::dot(normals[i], dir[t]));
-            ref[i] = s;
-        }
-    });
+    const std::vector<dvec3> ref = ibl::irradiance_texel_sum(cube, 0, std::span<const dvec3>(normals), ibl::thread_executor{});
     const auto c3 = ibl::project_cube<3>(
         n, [&](int f, int x, int y) { return dvec3(cube.texel(f, x, y, 0)); }, ibl::thread_executor{});
     const auto c2 = ibl::project_cube<2>(

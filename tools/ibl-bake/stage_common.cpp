@@ -11,6 +11,7 @@
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/prefilter.hpp>
+#include <ibl/integrate/reference.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
 
@@ -77,31 +78,11 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
     return ibl::bake_cubemap<float>(*src.map, n, k, ex, 0);
 }
 
-int level_at_most(const ibl::cubemap<float>& cube, int max_face) {
-    int level = 0;
-    while (cube.size(level) > max_face && level + 1 < cube.levels()) ++level;
-    return level;
-}
+int level_at_most(const ibl::cubemap<float>& cube, int max_face) { return ibl::irradiance_texel_sum_level(cube, max_face); }
 
 std::vector<dvec3> texel_sum_irradiance(const ibl::cubemap<float>& cube, int level, const std::vector<dvec3>& normals,
                                         pool_executor& ex) {
-    const int n = cube.size(level);
-    std::vector<dvec3> dir, rad;
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                dir.push_back(ibl::cube_texel_direction<double>(f, x, y, n));
-                rad.push_back(dvec3(cube.texel(f, x, y, level)) * ibl::cube_texel_solid_angle<double>(x, y, n));
-            }
-    std::vector<dvec3> e(normals.size());
-    ex(normals.size(), [&](std::size_t b, std::size_t end) {
-        for (std::size_t i = b; i < end; ++i) {
-            dvec3 s(0.0);
-            for (std::size_t t = 0; t < dir.size(); ++t) s += rad[t] * std::max(0.0, glm::dot(normals[i], dir[t]));
-            e[i] = s;
-        }
-    });
-    return e;
+    return ibl::irradiance_texel_sum(cube, level, std::span<const dvec3>(normals), ex);
 }
 
 image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level) {

@@ -68,11 +68,12 @@ product_view baked_view(const bake_context& ctx);
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
 
-/// The first level of `cube` whose face is <= max_face (the last level if none is).
+/// The first level of `cube` whose face is <= max_face (the last level if none is):
+/// ibl::irradiance_texel_sum_level.
 int level_at_most(const ibl::cubemap<float>& cube, int max_face);
 
 /// Irradiance E(n) at each normal by summing every texel of `level` (cosine-weighted, exact texel
-/// solid angles).
+/// solid angles): ibl::irradiance_texel_sum.
 std::vector<dvec3> texel_sum_irradiance(const ibl::cubemap<float>& cube, int level, const std::vector<dvec3>& normals,
                                         pool_executor& ex);
 
