@@ -97,6 +97,7 @@ const std::map<std::string, option_spec>& option_table() {
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
+        {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
              o.part = v;
@@ -129,6 +130,11 @@ const std::map<std::string, option_spec>& option_table() {
 
 /// Checks that need every option: required ones, combinations, --levels against --size.
 void check_combination(const bake_options& o, bool have_out) {
+    if (!o.lookup.empty()) {
+        if (have_out || !o.input.empty() || !o.scene.empty())
+            throw usage_error("--lookup DIR answers queries about an existing bake: no --out, --input or --scene");
+        return;
+    }
     if (!have_out) throw usage_error("--out DIR is required");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.levels > 0) {
@@ -172,6 +178,7 @@ bake_options parse_options(const std::vector<std::string>& args) {
 
 std::string usage_text() {
     return "usage: ibl-bake --out DIR [options]\n"
+           "       ibl-bake --lookup DIR < queries   (answers as the shader does; docs/ibl-bake.md)\n"
            "Bakes image-based-lighting products (prefiltered specular cubemap, SH irradiance, DFG LUT),\n"
            "a preview and an error/time report from a lat-long HDR image or the built-in sky.\n\n"
            "  --input PATH       Radiance .hdr, OpenEXR or KTX2: lat-long (2:1), cross (4:3 or 3:4), or six faces\n"
@@ -189,6 +196,8 @@ std::string usage_text() {
            "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
            "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
            "  --quiet            no progress on stderr\n"
+           "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
+           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --help, --version\n";

@@ -5,15 +5,18 @@
 //
 // Exit status: 0 success; 1 a failure while baking (unreadable / truncated / LDR input, a bad
 // scene file, a write error: the output directory is left as it was, see output_stage.hpp);
-// 2 bad command line.
+// 2 bad command line. --lookup: 0 when every query was answered, 1 otherwise (or when DIR
+// cannot be loaded).
 
 #include <cstdio>
 #include <exception>
+#include <iostream>
 #include <string>
 #include <vector>
 
 #include "bake_options.hpp"
 #include "pipeline.hpp"
+#include "lookup.hpp"
 #include "stages.hpp"
 
 int main(int argc, char** argv) {
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
         return 0;
     }
     try {
+        if (!opt.lookup.empty()) return run_lookup(load_baked_folder(opt.lookup), std::cin, std::cout);
         run_bake(opt, stdout);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "ibl-bake: error: %s\n", e.what());

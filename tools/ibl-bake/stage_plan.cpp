@@ -151,6 +151,16 @@ void plan_stage::report(json_writer& j) const {
     }
     j.key("runtime_lookup").value("lod = r * " + std::to_string(levels_ - 1) + " - " + std::to_string(plan_.specular.first_level) +
                                   " (linear policy over the virtual chain, minus the first stored level), clamped to the stored levels");
+    j.key("runtime").begin_object(); // what a loader (and ibl-bake --lookup) needs
+    j.key("policy").value("linear");
+    j.key("virtual_levels").value(plan_.specular.virtual_levels);
+    j.key("first_level").value(plan_.specular.first_level);
+    j.key("stored_levels").value(int(plan_.specular.levels.size()));
+    j.key("diffuse").value(diffuse_name(plan_.diffuse.kind));
+    j.key("sh_bands").value(plan_.diffuse.sh_bands);
+    j.key("dfg_size").value(plan_.dfg.size);
+    j.key("dfg_channels").value(plan_.dfg.channels);
+    j.end_object();
     j.key("products");
     plan_json(j, plan_, est_);
     if (scene_mode_) {

@@ -1,0 +1,204 @@
+// tools/ibl-bake/lookup.cpp — see lookup.hpp.
+
+#include "lookup.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <fstream>
+#include <istream>
+#include <iterator>
+#include <ostream>
+#include <sstream>
+#include <stdexcept>
+#include <vector>
+
+#include <ibl/sh/convolve.hpp>
+
+#include "json_value.hpp"
+#include "ktx2.hpp"
+
+namespace ibl_bake {
+
+namespace {
+
+using ibl_examples::json_value;
+
+std::string slurp(const std::string& path) {
+    const std::vector<unsigned char> b = read_file(path);
+    return std::string(b.begin(), b.end());
+}
+
+const json_value& member(const json_value& v, const char* key, const std::string& file) {
+    const json_value* m = v.find(key);
+    if (!m) throw std::runtime_error(file + ": missing \"" + key + "\"");
+    return *m;
+}
+
+ibl::cubemap<float> cube_from_ktx2(const std::string& path) {
+    const std::vector<unsigned char> bytes = read_file(path);
+    const cubemap_rgb32f k = decode_ktx2_cubemap(bytes, path);
+    ibl::cubemap<float> c(k.size, int(k.levels.size()));
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        c.fill(l, [&](int f, int x, int y) {
+            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+            return fvec3(t[0], t[1], t[2]);
+        });
+    }
+    c.update_borders();
+    return c;
+}
+
+ibl::dfg_lut lut_from_exr(const std::string& path, int channels) {
+    const image_rgb32f img = read_image(path);
+    if (img.width != img.height) throw std::runtime_error(path + ": the DFG table is not square");
+    ibl::dfg_lut lut;
+    lut.size = std::uint32_t(img.width);
+    lut.channels = std::uint32_t(std::clamp(channels, 2, 3));
+    lut.data.resize(std::size_t(lut.size) * lut.size * lut.channels);
+    for (std::uint32_t j = 0; j < lut.size; ++j)
+        for (std::uint32_t i = 0; i < lut.size; ++i)
+            for (std::uint32_t c = 0; c < lut.channels; ++c)
+                lut.data[(std::size_t(j) * lut.size + i) * lut.channels + c] = img.texel(int(i), int(j))[c];
+    return lut;
+}
+
+diffuse_data sh_from_json(const std::string& path) {
+    const json_value v = ibl_examples::parse_json(slurp(path));
+    diffuse_data d;
+    d.kind = ibl::diffuse_product::sh;
+    d.bands = int(member(v, "bands", path).number);
+    const json_value& k = member(v, "irradiance_over_pi_shader", path);
+    const json_value& r = member(v, "radiance", path);
+    if (k.values.size() > 9 || k.values.size() != r.values.size()) throw std::runtime_error(path + ": unexpected coefficient count");
+    for (std::size_t i = 0; i < k.values.size(); ++i)
+        for (int c = 0; c < 3; ++c) {
+            d.shader_over_pi[int(i)][c] = k.values[i].values.at(std::size_t(c)).number;
+            d.radiance[int(i)][c] = r.values[i].values.at(std::size_t(c)).number;
+        }
+    return d;
+}
+
+/// The numbers after the query word; false if one is not a finite number.
+bool numbers(std::istringstream& in, std::vector<double>& out) {
+    std::string w;
+    while (in >> w) {
+        double x = 0.0;
+        const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
+        if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x)) return false;
+        out.push_back(x);
+    }
+    return true;
+}
+
+std::string fmt9(double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.9g", x);
+    return b;
+}
+std::string triple(const dvec3& v) { return fmt9(v.x) + " " + fmt9(v.y) + " " + fmt9(v.z); }
+
+dvec3 unit(double x, double y, double z, const char* what) {
+    const dvec3 d(x, y, z);
+    const double l = std::sqrt(glm::dot(d, d));
+    if (!(l > 0.0) || !std::isfinite(l)) throw std::invalid_argument(std::string(what) + " is zero or not finite");
+    return d / l;
+}
+
+double unit_interval(double x) { return std::clamp(x, 0.0, 1.0); }
+
+/// One answer line for a query, or throws std::invalid_argument with the reason.
+std::string answer(const baked_folder& b, const product_view& v, const std::string& word, const std::vector<double>& a) {
+    auto need = [&](std::size_t n) {
+        if (a.size() != n)
+            throw std::invalid_argument("'" + word + "' takes " + std::to_string(n) + " numbers, got " + std::to_string(a.size()));
+    };
+    if (word == "specular") {
+        need(4);
+        if (!b.has_chain) throw std::invalid_argument("the bake has no specular chain");
+        return triple(v.sample(unit(a[0], a[1], a[2], "the direction"), unit(a[0], a[1], a[2], "the direction"), unit_interval(a[3])).ld);
+    }
+    if (word == "dfg") {
+        need(2);
+        if (!b.has_lut) throw std::invalid_argument("the bake has no DFG table");
+        const fvec3 ab = b.lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1])));
+        return fmt9(ab.x) + " " + fmt9(ab.y);
+    }
+    if (word == "irradiance") {
+        need(3);
+        if (b.diffuse.kind == ibl::diffuse_product::none) throw std::invalid_argument("the bake has no diffuse product");
+        return triple(ibl::pi_v<double> * b.diffuse.irradiance_over_pi(unit(a[0], a[1], a[2], "the normal")));
+    }
+    if (word == "shade") {
+        need(11);
+        const dvec3 n = unit(a[0], a[1], a[2], "the normal"), vv = unit(a[3], a[4], a[5], "the view direction");
+        ibl::pbr_material<double> m;
+        m.roughness = unit_interval(a[6]);
+        m.metallic = unit_interval(a[7]);
+        m.base_color = glm::clamp(dvec3(a[8], a[9], a[10]), dvec3(0.0), dvec3(1.0));
+        const auto shader = ibl::pbr_shader<double>::from(m, true);
+        return triple(shader.ambient(std::clamp(glm::dot(n, vv), 0.0, 1.0), v.sample(n, vv, m.roughness)));
+    }
+    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade)");
+}
+
+} // namespace
+
+product_view baked_folder::view() const {
+    product_view v;
+    v.chain = has_chain ? &chain : nullptr;
+    v.policy = ibl::roughness_mip_policy::linear();
+    v.virtual_levels = virtual_levels;
+    v.first_level = first_level;
+    v.lut = has_lut ? &lut : nullptr;
+    v.diffuse = &diffuse;
+    return v;
+}
+
+baked_folder load_baked_folder(const std::string& dir) {
+    const std::string rp = dir + "/report.json";
+    const json_value report = ibl_examples::parse_json(slurp(rp));
+    const json_value& rt = member(member(report, "plan", rp), "runtime", rp);
+    baked_folder b;
+    b.virtual_levels = int(member(rt, "virtual_levels", rp).number);
+    b.first_level = int(member(rt, "first_level", rp).number);
+    if (member(rt, "stored_levels", rp).number > 0) {
+        b.chain = cube_from_ktx2(dir + "/specular.ktx2");
+        b.has_chain = true;
+    }
+    if (member(rt, "dfg_size", rp).number > 0) {
+        b.lut = lut_from_exr(dir + "/dfg.exr", int(member(rt, "dfg_channels", rp).number));
+        b.has_lut = true;
+    }
+    const std::string diffuse = member(rt, "diffuse", rp).string;
+    if (diffuse == "sh") b.diffuse = sh_from_json(dir + "/sh.json");
+    else if (diffuse == "irradiance_map") {
+        b.diffuse.kind = ibl::diffuse_product::irradiance_map;
+        b.diffuse.map = cube_from_ktx2(dir + "/irradiance.ktx2");
+    }
+    return b;
+}
+
+int run_lookup(const baked_folder& b, std::istream& in, std::ostream& out) {
+    const product_view v = b.view();
+    std::string line;
+    int status = 0;
+    for (long n = 1; std::getline(in, line); ++n) {
+        std::istringstream ls(line);
+        std::string word;
+        if (!(ls >> word) || word[0] == '#') continue;
+        std::vector<double> a;
+        try {
+            if (!numbers(ls, a)) throw std::invalid_argument("expected numbers after '" + word + "'");
+            out << answer(b, v, word, a) << '\n';
+        } catch (const std::invalid_argument& e) {
+            out << "error: line " << n << ": " << e.what() << ": " << line << '\n';
+            status = 1;
+        }
+    }
+    out.flush();
+    return status;
+}
+
+} // namespace ibl_bake

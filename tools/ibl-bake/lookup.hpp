@@ -1,0 +1,45 @@
+#pragma once
+// tools/ibl-bake/lookup.hpp — `ibl-bake --lookup DIR`: answers queries about a bake folder exactly
+// as the documented runtime code does, from the files in DIR (report.json's plan.runtime,
+// specular.ktx2, dfg.exr, sh.json or irradiance.ktx2).
+//
+// Queries on stdin, one per line, one answer line each (numbers separated by spaces; lines that
+// are empty or start with # are skipped, without an answer):
+//   specular X Y Z R            -> r g b   LD for reflection direction (X,Y,Z) (normalised), roughness R
+//   dfg NV R                    -> A B     the DFG lookup (specular = LD (F0 A + F90 B))
+//   irradiance X Y Z            -> r g b   irradiance E (not E/pi) at the normal (X,Y,Z) (normalised)
+//   shade NX NY NZ VX VY VZ R M BR BG BB -> r g b   outgoing radiance of the runtime model (shade.hpp
+//                                 pbr_shader ambient, multiple scattering) for normal N, view V
+//                                 (towards the eye; both normalised), roughness R, metallic M,
+//                                 base colour B
+// R, NV, M are clamped to [0, 1] as the runtime does. A malformed query (unknown word, wrong count,
+// a non-number, a zero or non-finite direction) gets one line "error: line L: <why>: <the query>"
+// in place of its answer; the exit status is then 1 (0 when every query was answered).
+// Numbers are printed with 9 significant digits (they read back as the same float).
+
+#include <iosfwd>
+#include <string>
+
+#include "stages.hpp"
+
+namespace ibl_bake {
+
+/// The products of a bake folder as a renderer holds them (the chain as the KTX2 stores it).
+struct baked_folder {
+    ibl::cubemap<float> chain{1};
+    bool has_chain = false;
+    ibl::dfg_lut lut;
+    bool has_lut = false;
+    diffuse_data diffuse;
+    int virtual_levels = 1, first_level = 0;
+
+    product_view view() const;
+};
+
+/// Loads DIR. Throws image_error / std::runtime_error naming the file.
+baked_folder load_baked_folder(const std::string& dir);
+
+/// Answers the queries of `in` on `out` (see the header). Returns the exit status (0 or 1).
+int run_lookup(const baked_folder& b, std::istream& in, std::ostream& out);
+
+} // namespace ibl_bake
