@@ -400,3 +400,12 @@ TEST_CASE("limits: bake plan settings") {
     CHECK(f.specular.levels.size() == std::size_t(ibl::limits::max_plan_levels));
     CHECK(f.specular.levels.back().size == 1);
 }
+
+TEST_CASE("limits: compare_level checks its levels") {
+    const ibl::cubemap<float> a = constant_cube(4), b = constant_cube(4);
+    require_throw<std::invalid_argument>([&] { (void)ibl::compare_level(a, 99, b, 0); }, {"ibl::compare_level", "a_level = 99"});
+    require_throw<std::invalid_argument>([&] { (void)ibl::compare_level(a, 0, b, -1); }, {"b_level = -1"});
+    const std::vector<v3<float>> ref(6, v3<float>(1.f));
+    require_throw<std::invalid_argument>([&] { (void)ibl::compare_level(a, 3, std::span<const v3<float>>(ref)); }, {"level = 3"});
+    CHECK(ibl::compare_level(a, 2, std::span<const v3<float>>(ref)).max_abs == 0.0);
+}
