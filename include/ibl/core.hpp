@@ -5,6 +5,7 @@
 #include "core/constants.hpp"
 #include "core/frame.hpp"
 #include "core/gauss_legendre.hpp"
+#include "core/limits.hpp"
 #include "core/math.hpp"
 #include "core/sum.hpp"
 #include "core/vec.hpp"

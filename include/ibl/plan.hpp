@@ -117,7 +117,12 @@
 // ---- Bad input ------------------------------------------------------------------------------------
 //   Roughness outside [0, 1] is clamped with a warning (plan.warnings); a NaN roughness, metallic
 //   or error target, an error target <= 0, a scene without materials and max_reflection_pixels < 1
-//   throw std::invalid_argument. metallic outside [0, 1] is clamped with a warning.
+//   throw std::invalid_argument. metallic outside [0, 1] is clamped with a warning. plan_settings
+//   (make_bake_plan, full_bake_plan): levels in [1, limits::max_plan_levels], max_base_size in
+//   [1, limits::max_face_size], texel_fraction finite and > 0, filler_samples and the full bake's
+//   samples <= limits::max_samples, source_subsamples in [1, limits::max_subsamples], the full
+//   bake's dfg_size in [1, limits::max_dfg_lut_size]: std::invalid_argument below a domain,
+//   std::length_error above a bound (core/limits.hpp).
 
 #include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
@@ -131,6 +136,7 @@
 #include <vector>
 
 #include "core/constants.hpp"
+#include "core/limits.hpp"
 #include "integrate/roughness_mip.hpp"
 
 namespace ibl {
@@ -418,10 +424,23 @@ inline scene_description validate_scene(scene_description s, std::vector<std::st
     return s;
 }
 
+namespace detail {
+/// The settings' sizes and counts (the header's "Bad input"), checked for function fn.
+inline void check_plan_settings(const char* fn, const plan_settings& set) {
+    check_arg(fn, "plan_settings.levels", set.levels, 1, limits::max_plan_levels, "limits::max_plan_levels");
+    check_arg(fn, "plan_settings.max_base_size", set.max_base_size, 1, limits::max_face_size, "limits::max_face_size");
+    if (!(set.texel_fraction > 0.0) || !std::isfinite(set.texel_fraction))
+        throw std::invalid_argument(std::string("ibl::") + fn + ": plan_settings.texel_fraction must be a finite number > 0, got " +
+                                    fmt_num(set.texel_fraction));
+    check_total(fn, "plan_settings.filler_samples", set.filler_samples, limits::max_samples, "limits::max_samples");
+    check_arg(fn, "plan_settings.source_subsamples", set.source_subsamples, 1, limits::max_subsamples,
+              "limits::max_subsamples");
+}
+} // namespace detail
+
 /// The plan for a scene (the rules of the header).
 inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_settings& set = {}) {
-    if (set.levels < 1) throw std::invalid_argument("plan_settings: levels must be >= 1");
-    if (set.max_base_size < 1) throw std::invalid_argument("plan_settings: max_base_size must be >= 1");
+    detail::check_plan_settings("make_bake_plan", set);
     bake_plan p;
     const scene_description s = validate_scene(scene_in, p.warnings);
     p.scene = s.name;
@@ -451,7 +470,7 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
         if (!needed[std::size_t(v)]) continue;
         const double r = set.policy.roughness(double(v), L);
         const int n = face_size_for_roughness(r, set.texel_fraction, std::min(screen_cap, set.max_base_size));
-        base = std::max(base, n << v);
+        base = std::max(base, int(std::min<long long>((long long)n << v, set.max_base_size))); // n <= 2^16, v < 17
     }
     base = std::min(base, set.max_base_size);
     sp.virtual_base_size = base;
@@ -535,6 +554,9 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
 /// DFG table of dfg_size.
 inline bake_plan full_bake_plan(const plan_settings& set = {}, std::uint32_t samples = 512, bool trilinear = true,
                                 int dfg_size = 128) {
+    detail::check_plan_settings("full_bake_plan", set);
+    detail::check_total("full_bake_plan", "samples", samples, limits::max_samples, "limits::max_samples");
+    detail::check_arg("full_bake_plan", "dfg_size", dfg_size, 1, int(limits::max_dfg_lut_size), "limits::max_dfg_lut_size");
     bake_plan p;
     p.scene = "full";
     p.source_size = set.max_base_size;

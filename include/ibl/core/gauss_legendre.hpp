@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "constants.hpp"
+#include "limits.hpp"
 
 namespace ibl {
 
@@ -43,7 +44,10 @@ inline void legendre_and_derivative(std::size_t n, double t, double& p, double& 
 /// The n-point rule on [-1, 1] (n >= 1): weights sum to 2; nodes ascend, symmetric (the centre
 /// node of odd n is exactly 0). Newton's method to |dt| <= 4 eps, then the weight from P_n' at
 /// the converged node: nodes and weights to about 1 ulp for n up to several hundred.
+/// Throws std::invalid_argument for n = 0, std::length_error for n > limits::max_gauss_legendre_nodes.
 inline gauss_legendre_rule make_gauss_legendre_symmetric(std::size_t n) {
+    detail::check_arg("make_gauss_legendre", "n", n, std::size_t(1), limits::max_gauss_legendre_nodes,
+                      "limits::max_gauss_legendre_nodes");
     gauss_legendre_rule r{std::vector<double>(n), std::vector<double>(n)};
     const double nd = double(n);
     for (std::size_t i = 0; i < (n + 1) / 2; ++i) {
@@ -65,7 +69,7 @@ inline gauss_legendre_rule make_gauss_legendre_symmetric(std::size_t n) {
     return r;
 }
 
-/// The n-point rule on [0, 1] (n >= 1), x = (1 + t)/2, normalised to weights summing to 1.
+/// The n-point rule on [0, 1] (n >= 1; bounds as make_gauss_legendre_symmetric), x = (1 + t)/2, normalised to weights summing to 1.
 inline gauss_legendre_rule make_gauss_legendre(std::size_t n) {
     gauss_legendre_rule r = make_gauss_legendre_symmetric(n);
     for (std::size_t i = 0; i < n; ++i) {

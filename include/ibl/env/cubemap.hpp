@@ -51,6 +51,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -59,6 +60,7 @@
 #include "detail/level_solid_angle.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "cube_geometry.hpp"
@@ -94,21 +96,38 @@ template <class T> IBL_FUNC cube_coord<T> cube_lookup_select(const vec3<T>& r) n
 }
 } // namespace detail
 
+/// Texels a cubemap of face size `size` and `levels` levels stores (borders and every level
+/// included: sum over levels of 6 (n_l + 2)^2), levels = 0 meaning the full chain. Throws
+/// std::invalid_argument for size < 1 or levels outside [0, floor(log2 size) + 1], and
+/// std::length_error for size > limits::max_face_size or a total above limits::max_texels.
+inline std::size_t cubemap_storage_texels(int size, int levels = 0) {
+    detail::check_arg("cubemap", "face size", size, 1, limits::max_face_size, "limits::max_face_size");
+    const int full = detail::full_chain_levels(size);
+    if (levels < 0 || levels > full)
+        throw std::invalid_argument("ibl::cubemap: levels = " + std::to_string(levels) + " outside [0, " +
+                                    std::to_string(full) + "] for face size " + std::to_string(size));
+    if (levels == 0) levels = full;
+    std::uint64_t total = 0; // <= 17 * 6 * 65538^2 < 2^39: no overflow
+    for (int l = 0; l < levels; ++l) {
+        const std::uint64_t st = std::uint64_t(size >> l > 0 ? size >> l : 1) + 2;
+        total += 6 * st * st;
+    }
+    detail::check_total("cubemap", "stored texels", total, limits::max_texels, "limits::max_texels");
+    return std::size_t(total);
+}
+
 template <class T> class cubemap {
 public:
     using scalar_type = T;
     using value_type = vec3<T>;
 
     /// Face size n >= 1 at level 0; levels = 0 means the full chain down to 1 x 1. Texels are 0.
+    /// Throws std::invalid_argument for size < 1 or levels outside [0, full chain], and
+    /// std::length_error for size > limits::max_face_size or more than limits::max_texels stored
+    /// texels (cubemap_storage_texels), before allocating.
     explicit cubemap(int size, int levels = 0) {
-        if (size < 1)
-            throw std::invalid_argument("ibl::cubemap: face size must be >= 1, got " + std::to_string(size));
-        const int full = detail::full_chain_levels(size);
-        if (levels < 0 || levels > full)
-            throw std::invalid_argument("ibl::cubemap: levels must be in [0, " + std::to_string(full) +
-                                        "] for face size " + std::to_string(size) + ", got " +
-                                        std::to_string(levels));
-        if (levels == 0) levels = full;
+        const std::size_t total = cubemap_storage_texels(size, levels);
+        if (levels == 0) levels = detail::full_chain_levels(size);
         std::size_t offset = 0;
         for (int l = 0; l < levels; ++l) {
             level_info li;
@@ -120,16 +139,21 @@ public:
             offset += 6 * std::size_t(li.stride) * std::size_t(li.stride);
             levels_.push_back(li);
         }
-        data_.assign(offset, vec3<T>(T(0)));
+        IBL_ASSERT(offset == total);
+        data_.assign(total, vec3<T>(T(0)));
     }
 
-    [[nodiscard]] int size(int level = 0) const noexcept { return levels_[std::size_t(level)].n; }
+    /// Face size of a level. Safe for any level: a level outside [0, levels()) is clamped to the
+    /// chain (size(99) is the coarsest level's size), as bilinear() clamps its level.
+    [[nodiscard]] int size(int level = 0) const noexcept { return levels_[std::size_t(clamp_level(level))].n; }
     [[nodiscard]] int levels() const noexcept { return int(levels_.size()); }
     [[nodiscard]] T max_lod() const noexcept { return T(levels_.size() - 1); }
     /// True when the borders match the interiors (lookups are allowed).
     [[nodiscard]] bool borders_valid() const noexcept { return !borders_dirty_; }
 
     // ---- texel access (interior texels, x, y in [0, size(level))) ---------------------------
+    // Precondition (hot path, noexcept: checked by IBL_ASSERT in debug builds, not in release):
+    // 0 <= face < 6, 0 <= level < levels(), x and y in [0, size(level)). fill() throws instead.
 
     [[nodiscard]] const vec3<T>& texel(int face, int x, int y, int level = 0) const noexcept {
         return data_[index(face, x, y, level)];
@@ -141,8 +165,12 @@ public:
     }
     void set_texel(int face, int x, int y, int level, const vec3<T>& v) noexcept { texel_ref(face, x, y, level) = v; }
 
-    /// Sets every texel of a level to fn(face, x, y); marks the borders stale.
+    /// Sets every texel of a level to fn(face, x, y); marks the borders stale. Throws
+    /// std::invalid_argument unless 0 <= level < levels().
     template <class F> void fill(int level, F&& fn) {
+        if (level < 0 || level >= levels())
+            throw std::invalid_argument("ibl::cubemap::fill: level = " + std::to_string(level) + " outside [0, " +
+                                        std::to_string(levels()) + ")");
         const int n = size(level);
         for (int f = 0; f < 6; ++f)
             for (int y = 0; y < n; ++y)
@@ -257,6 +285,7 @@ private:
 
     /// Storage index of (face, x, y) with x, y in [-1, n] (border included).
     std::size_t index(int face, int x, int y, int level) const noexcept {
+        IBL_ASSERT(level >= 0 && level < levels());
         const level_info& li = levels_[std::size_t(level)];
         IBL_ASSERT(face >= 0 && face < 6 && x >= -1 && x <= li.n && y >= -1 && y <= li.n);
         const std::size_t st = std::size_t(li.stride);

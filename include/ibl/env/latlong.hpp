@@ -40,6 +40,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <stdexcept>
 #include <string>
@@ -49,6 +50,7 @@
 #include "detail/level_solid_angle.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "convert.hpp"
@@ -89,12 +91,38 @@ template <class T> IBL_FUNC T latlong_texel_solid_angle(int j, int width, int he
     return four_pi_v<T> / T(width) * sin(pi_v<T> * (T(j) + T(0.5)) / h) * sin(pi_v<T> / (T(2) * h));
 }
 
+/// Texels a latlong of width x height with `levels` levels stores (borders and every level
+/// included: sum over levels of (w_l + 2)(h_l + 2)), levels = 0 meaning the full chain. Throws
+/// std::invalid_argument for a side < 1 or levels outside [0, full chain], std::length_error for
+/// a side > limits::max_face_size or a total above limits::max_texels.
+inline std::size_t latlong_storage_texels(int width, int height, int levels = 0) {
+    detail::check_arg("latlong", "width", width, 1, limits::max_face_size, "limits::max_face_size");
+    detail::check_arg("latlong", "height", height, 1, limits::max_face_size, "limits::max_face_size");
+    const int full = detail::full_chain_levels(width > height ? width : height);
+    if (levels < 0 || levels > full)
+        throw std::invalid_argument("ibl::latlong: levels = " + std::to_string(levels) + " outside [0, " +
+                                    std::to_string(full) + "] for " + std::to_string(width) + " x " +
+                                    std::to_string(height));
+    if (levels == 0) levels = full;
+    std::uint64_t total = 0; // <= 17 * 65538^2 < 2^37: no overflow
+    for (int l = 0; l < levels; ++l) {
+        const std::uint64_t w = std::uint64_t(width >> l > 0 ? width >> l : 1) + 2;
+        const std::uint64_t h = std::uint64_t(height >> l > 0 ? height >> l : 1) + 2;
+        total += w * h;
+    }
+    detail::check_total("latlong", "stored texels", total, limits::max_texels, "limits::max_texels");
+    return std::size_t(total);
+}
+
 template <class T> class latlong {
 public:
     using scalar_type = T;
     using value_type = vec3<T>;
 
-    /// width, height >= 1; levels = 0 means the full chain. Texels are 0.
+    /// width, height >= 1; levels = 0 means the full chain. Texels are 0. Throws
+    /// std::invalid_argument for a size < 1 or levels outside [0, full chain], std::length_error
+    /// for a side > limits::max_face_size or more than limits::max_texels stored texels
+    /// (latlong_storage_texels), before allocating.
     latlong(int width, int height, int levels = 0) { init(width, height, levels); }
 
     /// Level 0 from interleaved linear RGB floats, row 0 = top (+Y), rgb.size() = 3 W H.
@@ -110,12 +138,15 @@ public:
         });
     }
 
-    [[nodiscard]] int width(int level = 0) const noexcept { return levels_[std::size_t(level)].w; }
-    [[nodiscard]] int height(int level = 0) const noexcept { return levels_[std::size_t(level)].h; }
+    /// Size of a level. Safe for any level: one outside [0, levels()) is clamped to the chain.
+    [[nodiscard]] int width(int level = 0) const noexcept { return levels_[std::size_t(clamp_level(level))].w; }
+    [[nodiscard]] int height(int level = 0) const noexcept { return levels_[std::size_t(clamp_level(level))].h; }
     [[nodiscard]] int levels() const noexcept { return int(levels_.size()); }
     [[nodiscard]] T max_lod() const noexcept { return T(levels_.size() - 1); }
     [[nodiscard]] bool borders_valid() const noexcept { return !borders_dirty_; }
 
+    // Texel access. Precondition (hot path, noexcept: IBL_ASSERT in debug builds, unchecked in
+    // release): 0 <= level < levels(), x in [0, width(level)), y in [0, height(level)).
     [[nodiscard]] const vec3<T>& texel(int x, int y, int level = 0) const noexcept {
         return data_[index(x, y, level)];
     }
@@ -125,8 +156,12 @@ public:
     }
     void set_texel(int x, int y, int level, const vec3<T>& v) noexcept { texel_ref(x, y, level) = v; }
 
-    /// Sets every texel of a level to fn(x, y); marks the borders stale.
+    /// Sets every texel of a level to fn(x, y); marks the borders stale. Throws
+    /// std::invalid_argument unless 0 <= level < levels().
     template <class F> void fill(int level, F&& fn) {
+        if (level < 0 || level >= levels())
+            throw std::invalid_argument("ibl::latlong::fill: level = " + std::to_string(level) + " outside [0, " +
+                                        std::to_string(levels()) + ")");
         for (int y = 0; y < height(level); ++y)
             for (int x = 0; x < width(level); ++x) data_[index(x, y, level)] = vec3<T>(fn(x, y));
         borders_dirty_ = true;
@@ -218,16 +253,13 @@ private:
     };
 
     static int min_int(int a, int b) noexcept { return a < b ? a : b; }
+    int clamp_level(int level) const noexcept {
+        return level < 0 ? 0 : (level >= levels() ? levels() - 1 : level);
+    }
 
     void init(int width, int height, int levels) {
-        if (width < 1 || height < 1)
-            throw std::invalid_argument("ibl::latlong: width and height must be >= 1, got " + std::to_string(width) +
-                                        " x " + std::to_string(height));
-        const int full = detail::full_chain_levels(width > height ? width : height);
-        if (levels < 0 || levels > full)
-            throw std::invalid_argument("ibl::latlong: levels must be in [0, " + std::to_string(full) + "], got " +
-                                        std::to_string(levels));
-        if (levels == 0) levels = full;
+        const std::size_t total = latlong_storage_texels(width, height, levels);
+        if (levels == 0) levels = detail::full_chain_levels(width > height ? width : height);
         std::size_t offset = 0;
         for (int l = 0; l < levels; ++l) {
             level_info li;
@@ -241,11 +273,13 @@ private:
             offset += std::size_t(li.stride) * std::size_t(li.h + 2);
             levels_.push_back(li);
         }
-        data_.assign(offset, vec3<T>(T(0)));
+        IBL_ASSERT(offset == total);
+        data_.assign(total, vec3<T>(T(0)));
     }
 
     /// Storage index of (x, y), x in [-1, w], y in [-1, h] (border included).
     std::size_t index(int x, int y, int level) const noexcept {
+        IBL_ASSERT(level >= 0 && level < levels());
         const level_info& li = levels_[std::size_t(level)];
         IBL_ASSERT(x >= -1 && x <= li.w && y >= -1 && y <= li.h);
         return li.offset + std::size_t(y + 1) * std::size_t(li.stride) + std::size_t(x + 1);
@@ -340,10 +374,12 @@ static_assert(environment<latlong<float>, float>);
 static_assert(environment<latlong<double>, double>);
 
 /// latlong -> cubemap of face size n by k x k supersampling of each texel (bake_cubemap), reading
-/// the lat-long map at `lod` (0 = finest, bilinear). Deterministic for any executor.
+/// the lat-long map at `lod` (0 = finest, bilinear). Deterministic for any executor. Throws as
+/// bake_cubemap (n, k and their work bounded by limits::max_face_size, max_subsamples, max_work).
 template <class T, class Executor = serial_executor>
 cubemap<T> latlong_to_cubemap(const latlong<T>& src, int n, int k, Executor&& ex = Executor{}, int levels = 0,
                               T lod = T(0)) {
+    detail::check_bake_args("latlong_to_cubemap", n, k);
     return bake_cubemap<T>(src, n, k, std::forward<Executor>(ex), levels, lod);
 }
 

@@ -56,6 +56,7 @@
 #include "../sampling/ggx.hpp"
 #include "../sampling/sequence.hpp"
 #include "../core/gauss_legendre.hpp"
+#include "../core/limits.hpp"
 
 namespace ibl {
 
@@ -87,10 +88,29 @@ struct dfg_quadrature_nodes {
     }
 };
 
+namespace detail {
+/// Every count of `nodes` in [1, limits::max_quadrature_nodes] (zero nodes would integrate
+/// nothing: E = 0 and k = (1 - E)/E = inf), checked for function `fn`.
+inline void check_dfg_nodes(const char* fn, const dfg_quadrature_nodes& nodes) {
+    const std::uint32_t hi = limits::max_quadrature_nodes;
+    check_arg(fn, "nodes.full_y", nodes.full_y, 1u, hi, "limits::max_quadrature_nodes");
+    check_arg(fn, "nodes.full_phi", nodes.full_phi, 1u, hi, "limits::max_quadrature_nodes");
+    check_arg(fn, "nodes.partial_y", nodes.partial_y, 1u, hi, "limits::max_quadrature_nodes");
+    check_arg(fn, "nodes.partial_phi", nodes.partial_phi, 1u, hi, "limits::max_quadrature_nodes");
+}
+/// samples <= limits::max_samples for function `fn` (std::length_error).
+inline void check_samples(const char* fn, const char* arg, std::uint32_t samples) {
+    check_total(fn, arg, samples, limits::max_samples, "limits::max_samples");
+}
+} // namespace detail
+
 /// The node tables of dfg_quadrature_nodes (host-only owner of the arrays the kernel reads).
+/// Throws std::invalid_argument for a zero count, std::length_error for a count above
+/// limits::max_quadrature_nodes.
 class dfg_quadrature_rule {
 public:
     explicit dfg_quadrature_rule(dfg_quadrature_nodes nodes = {}) : nodes_(nodes) {
+        detail::check_dfg_nodes("dfg_quadrature_rule", nodes);
         const gauss_legendre_rule fy = make_gauss_legendre(nodes.full_y);
         full_x_ = fy.x;
         full_w_ = fy.w;
@@ -159,7 +179,9 @@ template <class T> struct dfg_sample_table {
     std::vector<T> hx, hz;
 };
 
+/// n <= limits::max_samples (std::length_error beyond).
 template <class T> dfg_sample_table<T> make_dfg_sample_table(T alpha, std::uint32_t n) {
+    detail::check_samples("make_dfg_sample_table", "n", n);
     dfg_sample_table<T> t{std::vector<T>(n), std::vector<T>(n)};
     for (std::uint32_t i = 0; i < n; ++i) {
         const vec3<T> h = sample_ggx_ndf(hammersley<T>(i, n), alpha);
@@ -171,8 +193,10 @@ template <class T> dfg_sample_table<T> make_dfg_sample_table(T alpha, std::uint3
 
 /// Split-sum DFG terms (A, B) of model M by Monte Carlo with `samples` Hammersley points and GGX
 /// NDF importance sampling (the estimator of Karis 2013 / LearnOpenGL / Filament / glTF-IBL-
-/// Sampler); samples with n.l <= 0 count as zeros. The batch kernel at width 1. samples = 0 gives 0.
+/// Sampler); samples with n.l <= 0 count as zeros. The batch kernel at width 1. samples = 0 gives 0;
+/// samples > limits::max_samples throws std::length_error (the table holds 2 samples floats).
 template <class Model, class T> vec2<T> dfg_mc(T n_dot_v, T roughness, std::uint32_t samples) {
+    detail::check_samples("dfg_mc", "samples", samples);
     const dfg_sample_table<T> tab = make_dfg_sample_table(Model::alpha(roughness), samples);
     T e = T(0), b = T(0);
     dfg_mc_lanes<Model, 1>(tab.hx.data(), tab.hz.data(), samples, roughness, &n_dot_v, &e, &b);
@@ -182,8 +206,9 @@ template <class Model, class T> vec2<T> dfg_mc(T n_dot_v, T roughness, std::uint
 /// The literature's loop written plainly, one texel at a time (LearnOpenGL's IntegrateBRDF with
 /// the model's weight): for i < N: Xi = hammersley(i, N); H = sample_ggx_ndf(Xi, alpha);
 /// L = reflect(-V, H); if n.l > 0 accumulate G_Vis (1 - Fc), G_Vis Fc; divide by N. The baseline
-/// of the benchmarks and the oracle of the batch-kernel test.
+/// of the benchmarks and the oracle of the batch-kernel test. samples <= limits::max_samples.
 template <class Model, class T> vec2<T> dfg_mc_scalar_loop(T n_dot_v, T roughness, std::uint32_t samples) {
+    detail::check_samples("dfg_mc_scalar_loop", "samples", samples);
     const T mu = saturate(n_dot_v);
     const vec3<T> v(sin_from_cos(mu), T(0), mu);
     const T alpha = Model::alpha(roughness);
@@ -207,7 +232,9 @@ template <class Model, class T> vec2<T> dfg_mc_scalar_loop(T n_dot_v, T roughnes
 /// Benyoub 2023) of alpha = M::alpha(r): l = reflect(-v, h) has pdf_l = G1(v) D(h) / (4 n.v), so
 /// the weight is M::sample_weight (n.h) / ((v.h) G1(v)/(n.v)) (= 4 V (n.l) (n.v) / G1(v) for a
 /// GGX model: every sample lands where D is). Samples with n.l <= 0 count as zeros.
+/// samples <= limits::max_samples (std::length_error beyond).
 template <class Model, class T> vec2<T> dfg_mc_vndf(T n_dot_v, T roughness, std::uint32_t samples) {
+    detail::check_samples("dfg_mc_vndf", "samples", samples);
     const T mu = saturate(n_dot_v);
     const vec3<T> v(sin_from_cos(mu), T(0), mu);
     const T alpha = Model::alpha(roughness);

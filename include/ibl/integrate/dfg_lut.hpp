@@ -21,10 +21,13 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "../batch/dfg_kernel.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "dfg.hpp"
@@ -41,12 +44,21 @@ struct dfg_lut {
     double n_dot_v(std::uint32_t i) const noexcept { return (double(i) + 0.5) / double(size); }
     /// Roughness at the centre of row j.
     double roughness(std::uint32_t j) const noexcept { return (double(j) + 0.5) / double(size); }
+    /// Texel value. Precondition (noexcept, IBL_ASSERT in debug builds): i, j < size, c < channels,
+    /// data holds size^2 channels floats.
     float at(std::uint32_t i, std::uint32_t j, std::uint32_t c) const noexcept {
+        IBL_ASSERT(i < size && j < size && c < channels);
         return data[(std::size_t(j) * size + i) * channels + c];
     }
+    /// True when data holds size^2 * channels floats of a non-empty table (what sample() needs).
+    bool valid() const noexcept {
+        return size > 0 && channels > 0 && data.size() == std::size_t(size) * size * channels;
+    }
     /// Bilinear lookup at (n.v, r) with clamp-to-edge, as a GPU sampler does (channel 2 is 0 for a
-    /// two-channel table).
+    /// two-channel table). A table that is not valid() (empty, or data of the wrong length)
+    /// samples as 0 instead of reading out of bounds.
     vec3<float> sample(float n_dot_v, float rough) const noexcept {
+        if (!valid()) return vec3<float>(0.0f);
         const float fx = clamp(n_dot_v * float(size) - 0.5f, 0.0f, float(size - 1));
         const float fy = clamp(rough * float(size) - 0.5f, 0.0f, float(size - 1));
         const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
@@ -77,12 +89,30 @@ template <class T> void dfg_store(dfg_lut& lut, std::uint32_t i, std::uint32_t j
 }
 } // namespace detail
 
-/// The exact table of model M (quadrature in double), channels 2 or 3.
+namespace detail {
+/// size in [1, limits::max_dfg_lut_size], channels 2 or 3, size^2 * per_texel <= limits::max_work.
+inline void check_dfg_lut_args(const char* fn, std::uint32_t size, std::uint32_t channels, std::uint64_t per_texel,
+                               const char* per_texel_name) {
+    check_arg(fn, "size", size, 1u, limits::max_dfg_lut_size, "limits::max_dfg_lut_size");
+    if (channels != 2 && channels != 3)
+        throw std::invalid_argument(std::string("ibl::") + fn + ": channels must be 2 or 3, got " +
+                                    std::to_string(channels));
+    check_total(fn, per_texel_name, work_add(0, std::uint64_t(size) * size, per_texel), limits::max_work,
+                "limits::max_work");
+}
+} // namespace detail
+
+/// The exact table of model M (quadrature in double), channels 2 or 3. Throws
+/// std::invalid_argument for size 0, channels other than 2 or 3 or a zero node count,
+/// std::length_error for size > limits::max_dfg_lut_size, a node count above
+/// limits::max_quadrature_nodes or size^2 * nodes.evaluations() > limits::max_work.
 template <class Model, class Executor = thread_executor>
 dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_quadrature_nodes nodes = dfg_lut_default_nodes,
                            Executor&& ex = Executor{}) {
+    detail::check_dfg_nodes("make_dfg_lut_exact", nodes);
+    detail::check_dfg_lut_args("make_dfg_lut_exact", size, channels, nodes.evaluations(), "evaluations size^2 * nodes");
     constexpr std::size_t W = 16;
-    dfg_lut lut{size, channels < 3 ? 2u : 3u, {}};
+    dfg_lut lut{size, channels, {}};
     lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
     const dfg_quadrature_rule rule(nodes);
     const dfg_quadrature_view q = rule.view();
@@ -109,11 +139,15 @@ dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_q
 
 /// The Monte Carlo table of model M: `samples` Hammersley points with GGX-NDF sampling per texel
 /// (the literature's estimator, float), one sample table per row shared by its texels.
-/// Channels 2 or 3 (k from the Monte Carlo E).
+/// Channels 2 or 3 (k from the Monte Carlo E). Throws std::invalid_argument for size 0, samples 0
+/// (E = 0: k = inf) or channels other than 2 or 3, std::length_error for size >
+/// limits::max_dfg_lut_size, samples > limits::max_samples or size^2 * samples > limits::max_work.
 template <class Model, class Executor = thread_executor>
 dfg_lut make_dfg_lut_mc(std::uint32_t size, std::uint32_t samples, std::uint32_t channels = 2, Executor&& ex = Executor{}) {
+    detail::check_arg("make_dfg_lut_mc", "samples", samples, 1u, limits::max_samples, "limits::max_samples");
+    detail::check_dfg_lut_args("make_dfg_lut_mc", size, channels, samples, "evaluations size^2 * samples");
     constexpr std::size_t W = 16;
-    dfg_lut lut{size, channels < 3 ? 2u : 3u, {}};
+    dfg_lut lut{size, channels, {}};
     lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {

@@ -50,6 +50,7 @@
 
 #include "../core/color.hpp"
 #include "../core/constants.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../env/convert.hpp"
@@ -74,6 +75,9 @@ struct env_sample {
 };
 
 /// Luminance-times-solid-angle distribution over the texels of a cubemap (see the header).
+/// Throws std::invalid_argument for a level outside the chain, a uniform_fraction outside [0, 1]
+/// or stale borders, std::length_error for a level larger than limits::max_distribution_size
+/// (19 doubles per texel: choose a coarser level).
 class cube_env_distribution {
 public:
     template <class Tc>
@@ -86,6 +90,8 @@ public:
         if (!cube.borders_valid())
             throw std::invalid_argument("ibl::cube_env_distribution: cubemap borders are stale "
                                         "(call generate_mips() or update_borders())");
+        detail::check_total("cube_env_distribution", "face size of the level", cube.size(opt.level),
+                            limits::max_distribution_size, "limits::max_distribution_size");
         n_ = cube.size(opt.level);
         const std::size_t n = std::size_t(n_), rows = 6 * n;
         std::vector<double> omega(n * n), w(rows * n);
@@ -220,11 +226,15 @@ private:
 
 /// Distribution of any environment: bakes it into a cubemap of face size n with k x k
 /// sub-samples per texel (bake_cubemap, level 0 only) and builds the distribution from that.
-/// The cube is only the proposal; estimators keep evaluating env itself.
+/// The cube is only the proposal; estimators keep evaluating env itself. n and k as bake_cubemap
+/// (n also <= limits::max_distribution_size).
 template <class T, class Env>
     requires environment<Env, T>
 cube_env_distribution make_cube_env_distribution(const Env& env, int n, int k,
                                                  const cube_env_distribution_options& opt = {}) {
+    detail::check_bake_args("make_cube_env_distribution", n, k);
+    detail::check_total("make_cube_env_distribution", "n", n, limits::max_distribution_size,
+                        "limits::max_distribution_size");
     const cubemap<T> cube = bake_cubemap<T>(env, n, k, serial_executor{}, 1);
     return cube_env_distribution(cube, opt);
 }

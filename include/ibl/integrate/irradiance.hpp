@@ -31,6 +31,9 @@
 // level 0 (the literature). Output: irradiance_cubemap gives a one-level cubemap<float> of face
 // size `size` (32 by default: irradiance is smooth, its spectrum ends at SH band 2 to within 1%).
 // Non-finite radiance reads as 0; samples = 0 (or n_theta, n_phi = 0) are clamped to 1.
+// Limits (core/limits.hpp; std::length_error): samples and n_theta n_phi <= limits::max_samples,
+// n_theta, n_phi <= limits::max_face_size, size <= limits::max_face_size, and
+// irradiance_cubemap's 6 size^2 table size <= limits::max_work.
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
@@ -44,6 +47,7 @@
 
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/vec.hpp"
 #include "../env/cubemap.hpp"
 #include "../env/environment.hpp"
@@ -68,10 +72,22 @@ struct irradiance_options {
     double lod_bias = 0.5;
 };
 
+namespace detail {
+/// n_theta, n_phi <= limits::max_face_size and n_theta n_phi <= limits::max_samples (values < 1
+/// count as 1, as the tables clamp them).
+inline void check_irradiance_nodes(const char* fn, int n_theta, int n_phi) {
+    check_total(fn, "n_theta", n_theta, limits::max_face_size, "limits::max_face_size");
+    check_total(fn, "n_phi", n_phi, limits::max_face_size, "limits::max_face_size");
+    const std::uint64_t nt = std::uint64_t(n_theta > 0 ? n_theta : 1), np = std::uint64_t(n_phi > 0 ? n_phi : 1);
+    check_total(fn, "nodes n_theta * n_phi", nt * np, limits::max_samples, "limits::max_samples");
+}
+} // namespace detail
+
 /// Riemann (midpoint) table: n_theta x n_phi nodes, weights cos sin, scale pi^2 / N, not
 /// normalised. lod_of_solid_angle(node solid angle) gives each node's lod.
 template <class S, class LodFn>
 sphere_sample_table<S> make_irradiance_riemann_table(int n_theta, int n_phi, LodFn&& lod_of_solid_angle) {
+    detail::check_irradiance_nodes("make_irradiance_riemann_table", n_theta, n_phi);
     const int nt = n_theta > 0 ? n_theta : 1, np = n_phi > 0 ? n_phi : 1;
     const double dt = half_pi_v<double> / double(nt), dp = two_pi_v<double> / double(np);
     sphere_sample_table<S> t;
@@ -97,6 +113,7 @@ sphere_sample_table<S> make_irradiance_riemann_table(int n_theta, int n_phi, Lod
 /// down is not mixed with the horizon's sky). Lods use cos clamped to 1 / N (footprint <= pi sr).
 template <class S, class LodFn>
 sphere_sample_table<S> make_irradiance_cosine_table(std::uint32_t samples, LodFn&& lod_of_solid_angle) {
+    detail::check_total("make_irradiance_cosine_table", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
     sphere_sample_table<S> t;
     t.drawn = n;
@@ -111,8 +128,12 @@ sphere_sample_table<S> make_irradiance_cosine_table(std::uint32_t samples, LodFn
     return t;
 }
 
-/// The irradiance table for a source and options.
+/// The irradiance table for a source and options (limits as the header says; std::length_error).
 template <class S, class Env> sphere_sample_table<S> make_irradiance_table_for(const Env& env, const irradiance_options& opt) {
+    if (opt.method == irradiance_method::riemann)
+        detail::check_irradiance_nodes("irradiance", opt.n_theta, opt.n_phi);
+    else
+        detail::check_total("irradiance", "samples", opt.samples, limits::max_samples, "limits::max_samples");
     using Te = std::conditional_t<environment<Env, float>, float, double>;
     auto lod = [&](double omega) -> double {
         if (!opt.filtered) return 0.0;
@@ -132,7 +153,17 @@ template <class T, class Env>
 /// Irradiance cubemap (one level, face size opt.size) of an environment: E at every texel centre.
 template <class Env, class Executor = serial_executor>
 cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt = {}, Executor&& ex = Executor{}) {
-    if (opt.size < 1) throw std::invalid_argument("ibl::irradiance_cubemap: size must be >= 1, got " + std::to_string(opt.size));
+    detail::check_arg("irradiance_cubemap", "size", opt.size, 1, limits::max_face_size, "limits::max_face_size");
+    if (opt.method == irradiance_method::riemann)
+        detail::check_irradiance_nodes("irradiance_cubemap", opt.n_theta, opt.n_phi);
+    else
+        detail::check_total("irradiance_cubemap", "samples", opt.samples, limits::max_samples, "limits::max_samples");
+    const std::uint64_t per_texel = opt.method == irradiance_method::riemann
+                                        ? std::uint64_t(opt.n_theta > 0 ? opt.n_theta : 1) * std::uint64_t(opt.n_phi > 0 ? opt.n_phi : 1)
+                                        : std::uint64_t(opt.samples > 0 ? opt.samples : 1);
+    detail::check_total("irradiance_cubemap", "taps 6 size^2 samples",
+                        detail::work_add(0, 6 * std::uint64_t(opt.size) * std::uint64_t(opt.size), per_texel),
+                        limits::max_work, "limits::max_work");
     const int n = opt.size;
     cubemap<float> out(n, 1);
     const std::vector<vec3<float>> texels = convolve_faces(env, make_irradiance_table_for<float>(env, opt), n, ex);

@@ -24,6 +24,8 @@
 #include <cstddef>
 #include <limits>
 #include <span>
+#include <stdexcept>
+#include <string>
 
 #include "../core/vec.hpp"
 #include "../env/cubemap.hpp"
@@ -96,11 +98,22 @@ template <class A, class B>
     return acc.finish();
 }
 
+namespace detail {
+template <class C> void check_metric_level(const C& c, int level, const char* arg) {
+    if (level < 0 || level >= c.levels())
+        throw std::invalid_argument(std::string("ibl::compare_level: ") + arg + " = " + std::to_string(level) +
+                                    " outside [0, " + std::to_string(c.levels()) + ")");
+}
+} // namespace detail
+
 /// Metrics over every interior texel of one level of two cubemaps of equal size at that level
-/// (the levels may sit at different indices: a_level, b_level).
+/// (the levels may sit at different indices: a_level, b_level). Throws std::invalid_argument for a
+/// level outside its cubemap's chain.
 template <class A, class B>
 [[nodiscard]] error_metrics compare_level(const cubemap<A>& a, int a_level, const cubemap<B>& b, int b_level,
                                           double floor = 1e-30) {
+    detail::check_metric_level(a, a_level, "a_level");
+    detail::check_metric_level(b, b_level, "b_level");
     error_accumulator acc(floor);
     const int n = a.size(a_level);
     if (n != b.size(b_level)) return acc.finish();
@@ -111,10 +124,11 @@ template <class A, class B>
 }
 
 /// Metrics of a level against an array of reference texels in cubemap texel order
-/// (face, then row y, then column x).
+/// (face, then row y, then column x). Throws std::invalid_argument for a level outside the chain.
 template <class A, class B>
 [[nodiscard]] error_metrics compare_level(const cubemap<A>& a, int level, std::span<const vec3<B>> ref,
                                           double floor = 1e-30) {
+    detail::check_metric_level(a, level, "level");
     error_accumulator acc(floor);
     const int n = a.size(level);
     if (ref.size() < std::size_t(6) * std::size_t(n) * std::size_t(n)) return acc.finish();

@@ -58,7 +58,9 @@
 // Bad input: a table of 0 samples (make_ld_table) is clamped to 1 (one sample: h = n, l = R: a mirror lookup at the lod of
 // that sample's footprint). Non-finite source radiance reads as 0 (sphere_convolve.hpp); level 0
 // copies it as 0 too, so the output is finite. base_size < 1 for a source without a size (not a
-// cubemap) and levels < 0 throw std::invalid_argument.
+// cubemap) and levels < 0 throw std::invalid_argument; base_size > limits::max_face_size, samples
+// > limits::max_samples and more than limits::max_work taps in one call throw std::length_error
+// (core/limits.hpp).
 //
 // Determinism: the output depends only on the source and the options; each texel is computed by
 // the same operations whatever the executor (work items are face rows).
@@ -77,6 +79,7 @@
 
 #include "../brdf/ggx.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
@@ -135,9 +138,10 @@ inline std::uint32_t default_prefilter_samples(prefilter_method method, int leve
 
 /// The GGX LD sample table for one roughness (N = V = R): N Hammersley samples, n.l weights,
 /// lods from lod_of_solid_angle(Omega_s) (Omega_s = 4 / (N D(h))). Computed in double, stored as S.
-/// samples = 0 is clamped to 1.
+/// samples = 0 is clamped to 1; samples > limits::max_samples throws std::length_error.
 template <class S, class LodFn>
 sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, LodFn&& lod_of_solid_angle) {
+    detail::check_total("make_ld_table", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
     const double alpha = alpha_from_roughness(roughness);
     sphere_sample_table<S> t;
@@ -155,9 +159,11 @@ sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, Lo
 }
 
 /// The LD table of one level for a given source and options (the lod rule of the header comment).
+/// samples > limits::max_samples throws std::length_error.
 template <class S, class Env>
 sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::uint32_t samples,
                                          prefilter_method method, double lod_bias) {
+    detail::check_total("make_ld_table_for", "samples", samples, limits::max_samples, "limits::max_samples");
     return make_ld_table<S>(roughness, samples, [&](double omega_s) -> double {
         if (method == prefilter_method::importance) return 0.0;
         using Te = std::conditional_t<environment<Env, float>, float, double>;
@@ -169,6 +175,9 @@ sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::
 
 namespace detail {
 template <class Env> int prefilter_base_size(const Env& env, int base_size) {
+    if (base_size < 0)
+        throw std::invalid_argument("ibl::prefilter: base_size must be >= 0, got " + std::to_string(base_size));
+    detail::check_total("prefilter", "base_size", base_size, limits::max_face_size, "limits::max_face_size");
     if (base_size > 0) return base_size;
     if constexpr (requires { env.size(0); }) return env.size(0);
     throw std::invalid_argument("ibl::prefilter: base_size must be >= 1 for a source without a size");
@@ -224,13 +233,37 @@ inline std::uint32_t prefilter_samples(const prefilter_options& opt, int level, 
     return default_prefilter_samples(opt.method, level);
 }
 
+namespace detail {
+/// The sample counts of every level within limits::max_samples and the total taps within
+/// limits::max_work (prefilter's checks, before any table is built).
+inline void check_prefilter_work(const prefilter_options& opt, int base, int levels) {
+    check_total("prefilter", "samples", opt.samples, limits::max_samples, "limits::max_samples");
+    for (std::size_t l = 0; l < opt.samples_per_level.size(); ++l)
+        if (opt.samples_per_level[l] > limits::max_samples)
+            throw std::length_error("ibl::prefilter: samples_per_level[" + std::to_string(l) +
+                                    "] = " + std::to_string(opt.samples_per_level[l]) +
+                                    " exceeds limits::max_samples = " + std::to_string(limits::max_samples));
+    std::uint64_t work = 0;
+    for (int l = 1; l < levels; ++l) {
+        const std::uint64_t n = std::uint64_t(base >> l > 0 ? base >> l : 1);
+        work = work_add(work, 6 * n * n, std::uint64_t(prefilter_samples(opt, l, levels)) * (opt.trilinear ? 2u : 1u));
+    }
+    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l)", work, limits::max_work, "limits::max_work");
+}
+} // namespace detail
+
 /// The prefiltered mip chain of an environment: level l holds LD for roughness
 /// opt.policy.roughness(l, levels) at face size max(1, base >> l). Cubemap sources (with their mip
 /// chain generated) take the fast path; any other environment is evaluated per sample.
+/// Throws std::invalid_argument for base_size < 0 (or 0 without a source size) and levels < 0,
+/// std::length_error for base_size > limits::max_face_size, a level's samples (opt.samples or
+/// samples_per_level[l]) > limits::max_samples, or a total work sum over levels of
+/// 6 n_l^2 samples_l (x 2 when trilinear) > limits::max_work, before any work.
 template <class Env, class Executor = serial_executor>
 cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const int levels = prefilter_levels(opt, base);
+    detail::check_prefilter_work(opt, base, levels);
     cubemap<float> out(base, levels);
     auto store = [&](int level, const std::vector<vec3<float>>& texels) {
         const int n = out.size(level);

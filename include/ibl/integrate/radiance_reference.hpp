@@ -68,7 +68,8 @@
 //   samples within a batch, which QMC violates on purpose). Batches are computed through the
 //   executor and folded in batch order: the result depends only on the inputs and options.
 //   samples = total radiance evaluations (draws) over all batches; per batch samples / batches
-//   (at least 1), batches >= 2. The mirror term costs one more evaluation and has zero error.
+//   (at least 1), batches >= 2 (smaller counts are raised to 2); samples <= limits::max_samples and
+//   batches <= limits::max_batches (core/limits.hpp; std::length_error beyond). The mirror term costs one more evaluation and has zero error.
 //   Caveat (every sample-based error bar has it): a bright feature that no batch hits is
 //   invisible to the standard error. BRDF sampling alone under the default sky's sun at 1024
 //   samples returns a value 99% low with a 0.4% standard error (bench_radiance_reference); with
@@ -104,6 +105,7 @@
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../env/environment.hpp"
@@ -259,7 +261,8 @@ struct rr_batch {
 /// integral g(l) L(l) d(omega_l) for a lobe g (concept product_lobe) by MIS of the lobe's sampler
 /// and the environment distribution `dist` (nullptr: lobe sampling only), with the batching and
 /// scrambling described in the header. Throws std::invalid_argument for strategy env without a
-/// distribution or env_fraction outside [0, 1].
+/// distribution or env_fraction outside [0, 1], std::length_error for opt.samples >
+/// limits::max_samples or opt.batches > limits::max_batches.
 template <class Lobe, class Env, class Executor = serial_executor>
     requires product_lobe<Lobe>
 product_estimate integrate_product_mis(const Env& env, const cube_env_distribution* dist, const Lobe& lobe,
@@ -268,6 +271,8 @@ product_estimate integrate_product_mis(const Env& env, const cube_env_distributi
         throw std::invalid_argument("ibl::integrate_product_mis: strategy env needs an environment distribution");
     if (!(opt.env_fraction >= 0.0 && opt.env_fraction <= 1.0))
         throw std::invalid_argument("ibl::integrate_product_mis: env_fraction must be in [0, 1]");
+    detail::check_total("integrate_product_mis", "samples", opt.samples, limits::max_samples, "limits::max_samples");
+    detail::check_total("integrate_product_mis", "batches", opt.batches, limits::max_batches, "limits::max_batches");
     const std::uint32_t batches = opt.batches >= 2 ? opt.batches : 2;
     const std::uint32_t per_batch = opt.samples / batches > 0 ? opt.samples / batches : 1;
     std::uint32_t n_e = 0;

@@ -61,6 +61,7 @@
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/sum.hpp"
 #include "../core/vec.hpp"
@@ -128,8 +129,10 @@ inline double ggx_ld_normaliser(double alpha) {
 
 /// LD at unit direction R for perceptual roughness r: GGX importance sampling, n.l weights,
 /// `samples` Hammersley points (0 -> 1), lod 0, double. Any environment.
+/// samples > limits::max_samples throws std::length_error.
 template <class Env> vec3<double> reference_ld(const Env& env, const vec3<double>& dir, double roughness,
                                                std::uint32_t samples) {
+    detail::check_total("reference_ld", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
     const double alpha = alpha_from_roughness(roughness);
     const frame<double> fr = make_frame(glm::normalize(dir));
@@ -148,9 +151,13 @@ template <class Env> vec3<double> reference_ld(const Env& env, const vec3<double
 }
 
 /// LD of a sky_environment with its sun handled by quadrature (see the header). Deterministic.
+/// sky_samples <= limits::max_samples, cap_nodes <= limits::max_cap_nodes (std::length_error;
+/// cap_nodes < 1 counts as 1).
 template <class T>
 vec3<double> reference_ld_sky(const sky_environment<T>& sky, const vec3<double>& dir, double roughness,
                               std::uint32_t sky_samples = 4096, int cap_nodes = 32) {
+    detail::check_total("reference_ld_sky", "sky_samples", sky_samples, limits::max_samples, "limits::max_samples");
+    detail::check_total("reference_ld_sky", "cap_nodes", cap_nodes, limits::max_cap_nodes, "limits::max_cap_nodes");
     sky_environment<T> no_sun = sky;
     no_sun.sun_radiance = vec3<T>(T(0));
     const vec3<double> R = glm::normalize(dir);
@@ -172,8 +179,9 @@ vec3<double> reference_ld_sky(const sky_environment<T>& sky, const vec3<double>&
 }
 
 /// Irradiance E at unit normal n: pi * mean of L over `samples` cosine-distributed Hammersley
-/// directions (0 -> 1), lod 0, double.
+/// directions (0 -> 1), lod 0, double. samples > limits::max_samples throws std::length_error.
 template <class Env> vec3<double> reference_irradiance(const Env& env, const vec3<double>& normal, std::uint32_t samples) {
+    detail::check_total("reference_irradiance", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
     const frame<double> fr = make_frame(glm::normalize(normal));
     detail::neumaier3 acc;
@@ -184,10 +192,13 @@ template <class Env> vec3<double> reference_irradiance(const Env& env, const vec
     return acc.value() * (pi_v<double> / double(n));
 }
 
-/// Irradiance of a sky_environment with its sun by cap quadrature (see the header).
+/// Irradiance of a sky_environment with its sun by cap quadrature (see the header). Limits as
+/// reference_ld_sky.
 template <class T>
 vec3<double> reference_irradiance_sky(const sky_environment<T>& sky, const vec3<double>& normal,
                                       std::uint32_t sky_samples = 4096, int cap_nodes = 32) {
+    detail::check_total("reference_irradiance_sky", "sky_samples", sky_samples, limits::max_samples, "limits::max_samples");
+    detail::check_total("reference_irradiance_sky", "cap_nodes", cap_nodes, limits::max_cap_nodes, "limits::max_cap_nodes");
     sky_environment<T> no_sun = sky;
     no_sun.sun_radiance = vec3<T>(T(0));
     const vec3<double> nn = glm::normalize(normal);
@@ -259,8 +270,12 @@ std::vector<vec3<double>> irradiance_texel_sum(const cubemap<T>& c, int level, s
 
 /// fn(unit direction) at every texel centre of an n x n-per-face cube, in cubemap order
 /// (face, y, x), through the executor (work items: face rows). For references of whole levels.
+/// Throws std::invalid_argument for n < 1, std::length_error for 6 n^2 > limits::max_texels.
 template <class F, class Executor = serial_executor>
 std::vector<vec3<double>> reference_faces(int n, F&& fn, Executor&& ex = Executor{}) {
+    detail::check_arg("reference_faces", "n", n, 1, limits::max_face_size, "limits::max_face_size");
+    detail::check_total("reference_faces", "texels 6 n^2", 6 * std::uint64_t(n) * std::uint64_t(n), limits::max_texels,
+                        "limits::max_texels");
     std::vector<vec3<double>> out(std::size_t(6) * std::size_t(n) * std::size_t(n));
     ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
         for (std::size_t row = b; row < e; ++row) {

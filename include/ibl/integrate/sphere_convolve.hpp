@@ -40,6 +40,7 @@
 #include "../batch/sphere_kernel.hpp"
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
@@ -122,10 +123,17 @@ template <class S> tap_table make_taps(const sphere_sample_table<S>& table, int 
 
 /// Convolves every texel of an n x n-per-face output (texel centres) with a table, through the
 /// executor (work items: face rows). Returns the texels in cubemap order (face, y, x).
-/// Cubemap sources take the fast path; other environments the generic evaluator.
+/// Cubemap sources take the fast path; other environments the generic evaluator. Throws
+/// std::invalid_argument for n < 1, std::length_error for n > limits::max_face_size or
+/// 6 n^2 table.size() (x 2 for trilinear tables) > limits::max_work.
 template <class Env, class S, class Executor = serial_executor>
 std::vector<vec3<float>> convolve_faces(const Env& env, const sphere_sample_table<S>& table, int n,
                                         Executor&& ex = Executor{}) {
+    detail::check_arg("convolve_faces", "n", n, 1, limits::max_face_size, "limits::max_face_size");
+    detail::check_total("convolve_faces", "taps 6 n^2 samples",
+                        detail::work_add(0, 6 * std::uint64_t(n) * std::uint64_t(n),
+                                         std::uint64_t(table.size()) * (table.trilinear ? 2u : 1u)),
+                        limits::max_work, "limits::max_work");
     std::vector<vec3<float>> out(std::size_t(6) * std::size_t(n) * std::size_t(n));
     if constexpr (requires { detail::pack_cube(env); }) {
         const detail::packed_cube src = detail::pack_cube(env);

@@ -59,6 +59,9 @@
 #include <concepts>
 #include <cstddef>
 #include <cstdlib>
+#include <limits>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -66,6 +69,7 @@
 #include "../core/gauss_legendre.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/sum.hpp"
 #include "../core/vec.hpp"
@@ -211,6 +215,15 @@ sh_accumulator<B> sh_ring_row(const double* cos_phi, const double* sin_phi, int 
     return acc;
 }
 
+/// level >= 0, and level < src.levels() when the source type has levels().
+template <class Src> void check_sh_level(const char* fn, const Src& src, int level) {
+    int count = std::numeric_limits<int>::max();
+    if constexpr (requires { { src.levels() } -> std::convertible_to<int>; }) count = int(src.levels());
+    if (level < 0 || level >= count)
+        throw std::invalid_argument(std::string("ibl::") + fn + ": level = " + std::to_string(level) +
+                                    " outside [0, " + std::to_string(count) + ")");
+}
+
 template <class F, class T>
 concept sh_direction_callable = requires(const F& f, vec3<T> d) {
     { f(d) } -> std::convertible_to<vec3<T>>;
@@ -224,11 +237,12 @@ concept sh_radiance_source = requires(const F& f, vec3<T> d) {
 
 /// Projection of an n x n-per-face cube given texel by texel: fetch(face, x, y) -> vec3<T> is the
 /// radiance of texel (x, y) of face 0..5 (cube_geometry.hpp). Returns radiance SH coefficients.
+/// Throws std::invalid_argument for n < 1, std::length_error for n > limits::max_face_size.
 template <int B, class Fetch, class Executor = serial_executor>
 auto project_cube(int n, Fetch&& fetch, Executor&& ex = {}) {
     using V = std::remove_cvref_t<decltype(fetch(0, 0, 0))>;
     using T = typename V::value_type;
-    IBL_ASSERT(n >= 1);
+    detail::check_arg("project_cube", "n", n, 1, limits::max_face_size, "limits::max_face_size");
     const detail::cube_weight_table table(n);
     const double inv_n = 1.0 / double(n);
     using dvec = vec3<double>;
@@ -277,13 +291,15 @@ auto project_cube(int n, Fetch&& fetch, Executor&& ex = {}) {
 
 /// Projection of level `level` of a cube object with the face-texel accessor interface
 ///   cube.size(level) -> int (face size), cube.texel(face, x, y, level) -> vec3<T>
-/// (ibl::cubemap<T> satisfies it).
+/// (ibl::cubemap<T> satisfies it). Throws std::invalid_argument for level < 0, or level >=
+/// cube.levels() when the type has levels().
 template <int B, class Cube, class Executor = serial_executor>
     requires requires(const Cube& c) {
         { c.size(0) } -> std::convertible_to<int>;
         c.texel(0, 0, 0, 0);
     }
 auto project_cube(const Cube& cube, Executor&& ex = {}, int level = 0) {
+    detail::check_sh_level("project_cube", cube, level);
     return project_cube<B>(
         int(cube.size(level)), [&](int face, int x, int y) { return cube.texel(face, x, y, level); },
         std::forward<Executor>(ex));
@@ -293,11 +309,13 @@ auto project_cube(const Cube& cube, Executor&& ex = {}, int level = 0) {
 /// y = row from the top = +Y). Row j spans latitudes [lat_b, lat_t] = pi/2 - [(j+1), j] pi/H; its
 /// texels have the exact solid angle (2pi/W)(sin lat_t - sin lat_b), evaluated as
 /// (2pi/W) 2 cos(lat_c) sin(pi/(2H)) (no cancellation at the poles).
+/// Throws std::invalid_argument for a side < 1, std::length_error for a side > limits::max_face_size.
 template <int B, class Fetch, class Executor = serial_executor>
 auto project_latlong(int width, int height, Fetch&& fetch, Executor&& ex = {}) {
     using V = std::remove_cvref_t<decltype(fetch(0, 0))>;
     using T = typename V::value_type;
-    IBL_ASSERT(width >= 1 && height >= 1);
+    detail::check_arg("project_latlong", "width", width, 1, limits::max_face_size, "limits::max_face_size");
+    detail::check_arg("project_latlong", "height", height, 1, limits::max_face_size, "limits::max_face_size");
     std::vector<double> cos_phi(static_cast<std::size_t>(width)), sin_phi(static_cast<std::size_t>(width));
     for (int i = 0; i < width; ++i) {
         const double phi = two_pi_v<double> * (double(i) + 0.5) / double(width) - pi_v<double>;
@@ -323,7 +341,8 @@ auto project_latlong(int width, int height, Fetch&& fetch, Executor&& ex = {}) {
 
 /// Projection of level `level` of a lat-long image object with the accessor interface
 ///   img.width(level), img.height(level) -> int, img.texel(x, y, level) -> vec3<T>
-/// (ibl::latlong<T> satisfies it; same orientation as the fetch overload).
+/// (ibl::latlong<T> satisfies it; same orientation as the fetch overload). Level checked as
+/// project_cube's.
 template <int B, class Image, class Executor = serial_executor>
     requires requires(const Image& img) {
         { img.width(0) } -> std::convertible_to<int>;
@@ -331,6 +350,7 @@ template <int B, class Image, class Executor = serial_executor>
         img.texel(0, 0, 0);
     }
 auto project_latlong(const Image& img, Executor&& ex = {}, int level = 0) {
+    detail::check_sh_level("project_latlong", img, level);
     return project_latlong<B>(
         int(img.width(level)), int(img.height(level)), [&](int x, int y) { return img.texel(x, y, level); },
         std::forward<Executor>(ex));
@@ -342,8 +362,9 @@ template <int B> struct sh_quadrature_size {
     int azimuths;             ///< M (uniform in phi)
     int exact_degree;         ///< D = degree + B - 1: integrand degree integrated exactly
 };
+/// degree is clamped to [0, limits::max_sh_degree] (no int overflow; project_function throws above).
 template <int B> [[nodiscard]] inline sh_quadrature_size<B> sh_quadrature_for(int degree) noexcept {
-    const int d = std::max(degree, 0) + B - 1;
+    const int d = std::clamp(degree, 0, limits::max_sh_degree) + B - 1;
     return {(d + 2) / 2, d + 1, d};
 }
 
@@ -351,10 +372,12 @@ template <int B> [[nodiscard]] inline sh_quadrature_size<B> sh_quadrature_for(in
 /// (f.radiance(dir, lod) -> vec3<T>, read at lod 0) by the deterministic product quadrature of
 /// the header comment: exact for radiance that is a polynomial of degree <= `degree` on each
 /// hemisphere (y >= 0, y <= 0), spectrally convergent for smooth radiance as `degree` grows.
-/// Rings (one per y node) are the blocks of the executor.
+/// Rings (one per y node) are the blocks of the executor. A negative degree counts as 0;
+/// degree > limits::max_sh_degree throws std::length_error.
 template <int B, class T, class F, class Executor = serial_executor>
     requires detail::sh_direction_callable<F, T> || detail::sh_radiance_source<F, T>
 sh_coeffs<T, B> project_function(const F& f, int degree, Executor&& ex = {}) {
+    detail::check_total("project_function", "degree", degree, limits::max_sh_degree, "limits::max_sh_degree");
     const auto q = sh_quadrature_for<B>(degree);
     std::vector<double> node, weight;
     detail::gauss_legendre(q.nodes_per_hemisphere, node, weight);

@@ -30,6 +30,7 @@
 
 #include "../core/constants.hpp"
 #include "../core/frame.hpp"
+#include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "basis.hpp"
@@ -57,6 +58,11 @@ IBL_FUNC sh_coeffs<T, B> sh_apply_window(const sh_coeffs<T, B>& c, sh_window_kin
     return sh_scale_bands(c, w);
 }
 
+/// Largest Fibonacci sample count of sh_min_value (2^20 SH evaluations: well past the 4096 that
+/// resolve every basin for B <= 5), and the smallest pattern-search step (about 40 halvings).
+inline constexpr int sh_max_min_samples = 1 << 20;
+inline constexpr double sh_min_step_floor = 1e-12;
+
 /// Minimum of each channel of a function given by SH coefficients, and where it occurs.
 template <class T> struct sh_minimum {
     vec3<T> value;  ///< per-channel minimum found
@@ -79,11 +85,15 @@ template <class T> IBL_FUNC vec3<T> sh_fibonacci_dir(int i, int n) noexcept {
 /// Per-channel minimum over the sphere of f(n) = sum_k c_k Y_k(n) (pass irradiance SH to minimise
 /// irradiance). `samples` Fibonacci directions, then a pattern search (8 tangent directions,
 /// step halved on failure, down to `min_step` radians) from the best sample of each channel.
+/// Device-callable, so it never throws: samples is clamped to [1, sh_max_min_samples] and min_step
+/// to >= sh_min_step_floor (a NaN min_step counts as that floor), which bounds the work.
 template <class T, int B>
 IBL_FUNC sh_minimum<T> sh_min_value(const sh_coeffs<T, B>& c, int samples = 4096, T min_step = T(1e-6)) noexcept {
     using std::cos;
     using std::sin;
     using std::sqrt;
+    samples = samples < 1 ? 1 : (samples > sh_max_min_samples ? sh_max_min_samples : samples);
+    if (!(min_step >= T(sh_min_step_floor))) min_step = T(sh_min_step_floor);
     sh_minimum<T> best;
     for (int ch = 0; ch < 3; ++ch) {
         best.value[ch] = T(0);
@@ -143,20 +153,39 @@ template <class T, int B> struct sh_auto_window_result {
     T width;                   ///< chosen W; +infinity when no window was needed
     vec3<T> min_before;        ///< per-channel minimum irradiance of the input
     vec3<T> min_after;         ///< per-channel minimum irradiance after windowing (>= 0 if ok)
-    bool ok;                   ///< false only if even W = 1 (band 0 alone) is negative: L_00 < 0
+    bool ok;                   ///< false if even W = 1 (band 0 alone) is negative (L_00 < 0), or for
+                               ///< a non-finite coefficient or max_width (then width is NaN)
 };
 
 /// The weakest window of options.kind keeping the irradiance non-negative in every channel.
+/// Device-callable, so it never throws: a non-finite coefficient or a non-finite max_width gives
+/// ok = false, width = NaN and the input unchanged (no search); max_width is clamped to
+/// [1, 2^20], iterations to [0, 64] and samples as sh_min_value clamps them, which bounds the work.
 template <class T, int B>
 IBL_FUNC sh_auto_window_result<T, B> sh_auto_window(const sh_coeffs<T, B>& radiance,
-                                                     const sh_auto_window_options& options = {}) noexcept {
+                                                     const sh_auto_window_options& options_in = {}) noexcept {
     using std::exp;
     using std::log;
+    sh_auto_window_result<T, B> r;
+    bool finite = is_finite(options_in.max_width);
+    for (int k = 0; k < B * B; ++k)
+        finite = finite && is_finite(radiance.c[k].x) && is_finite(radiance.c[k].y) && is_finite(radiance.c[k].z);
+    if (!finite) {
+        const T nan = std::numeric_limits<T>::quiet_NaN();
+        r.radiance = radiance;
+        r.width = nan;
+        r.min_before = vec3<T>(nan);
+        r.min_after = vec3<T>(nan);
+        r.ok = false;
+        return r;
+    }
+    sh_auto_window_options options = options_in;
+    options.max_width = options.max_width < 1.0 ? 1.0 : (options.max_width > 0x1p20 ? 0x1p20 : options.max_width);
+    options.iterations = options.iterations < 0 ? 0 : (options.iterations > 64 ? 64 : options.iterations);
     auto min3 = [](const vec3<T>& v) { return v.x < v.y ? (v.x < v.z ? v.x : v.z) : (v.y < v.z ? v.y : v.z); };
     auto min_at = [&](T width) {
         return sh_min_irradiance(sh_apply_window(radiance, options.kind, width), options.samples).value;
     };
-    sh_auto_window_result<T, B> r;
     r.min_before = sh_min_irradiance(radiance, options.samples).value;
     if (min3(r.min_before) >= T(0)) {
         r.radiance = radiance;
