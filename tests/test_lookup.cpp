@@ -99,8 +99,8 @@ TEST_CASE("specular lookup: exact level at its roughness, constant environment e
                 const ibl::vec3<float> v = ibl::specular_lookup(one, dir, 0.05f * float(k), d);
                 for (int q = 0; q < 3; ++q) CHECK(double(v[q]) == doctest::Approx(0.75).epsilon(2 * feps));
             }
-    // The two-level lookup is the trilinear read at the lod it reports (what textureLod does).
-    const ibl::specular_lookup_desc d{};
+    // A linear two-level lookup is the trilinear read at the lod it reports (what textureLod does).
+    for (const auto& d : {k_schemes[0], k_schemes[2], k_schemes[3]})
     for (int k = 0; k <= 20; ++k) {
         const float r = 0.05f * float(k);
         const ibl::specular_taps<float> s = ibl::specular_lookup_taps(r, c.levels(), d);
@@ -214,8 +214,9 @@ double m1(double r) {
 } // namespace
 
 TEST_CASE("specular interpolation error on a smooth environment matches its closed form") {
-    // L(d) = 2 + d.y: LD is linear in R.y with slope m1(r), so the blend of exact levels is off by
-    // R.y (sum_k w_k m1(r_k) - m1(r)) exactly; the metric's interpolation part must equal that.
+    // L(d) = 2 + d.y: LD is linear in R.y with slope m1(r), so the blend of exact levels is known
+    // in closed form per direction (for the linear blend it is off by R.y (sum_k w_k m1(r_k) -
+    // m1(r))); the metric's interpolation part must equal that.
     // The chain holds the exact LD at its texel centres (levels part: bilinear on the cube only).
     const int levels = 6;
     ibl::cubemap<float> chain(32, levels);
@@ -240,13 +241,13 @@ TEST_CASE("specular interpolation error on a smooth environment matches its clos
         REQUIRE(rep.size() == rs.size());
         for (const auto& x : rep) {
             const ibl::specular_taps<double> s = ibl::specular_lookup_taps(x.roughness, levels, desc);
-            double blend = 0.0;
-            for (int k = 0; k < s.count; ++k) blend += s.weight[k] * m1(double(s.level[k]) / (levels - 1));
-            const double dm = blend - m1(x.roughness);
+            // The scheme's blend (linear or geometric) of the closed-form level values, per direction.
             double sq = 0.0;
             for (const auto& d : dirs) {
-                const double y = glm::normalize(d).y;
-                sq += ibl::sqr(y * dm / (2.0 + y * m1(x.roughness)));
+                const double y = glm::normalize(d).y, exact = 2.0 + y * m1(x.roughness);
+                d3 v[4];
+                for (int k = 0; k < s.count; ++k) v[k] = d3(2.0 + y * m1(double(s.level[k]) / (levels - 1)));
+                sq += ibl::sqr((ibl::specular_blend(s, v, desc).x - exact) / exact);
             }
             CHECK(x.interpolation.rel_rmse == doctest::Approx(std::sqrt(sq / double(dirs.size()))).epsilon(1e-9));
             // m1 lies in [0, 1] and changes by < 1 between levels: the blend is off by < 0.2 of

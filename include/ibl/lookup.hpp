@@ -87,12 +87,15 @@ enum class level_interpolation : int {
 };
 
 /// How a renderer reads the specular chain at a roughness (see the header). The default is the
-/// scheme chosen from the measurements of docs/lookup.md.
+/// best two-tap scheme measured (docs/lookup.md): t linear in log r, geometric blend (per channel
+/// L_l^(1 - t) L_{l+1}^t), which is exact wherever LD follows a power law in r: in a bright
+/// source's GGX tail (LD ~ alpha^2 = r^4) and at its peak (LD ~ 1 / alpha^2 = r^-4). GPU cost:
+/// two textureLod at integer lods, one log per lookup for t, one exp2/log2 pair per channel.
 struct specular_lookup_desc {
     roughness_mapping mapping = roughness_mapping::linear; ///< what the bake stored per level
-    level_weight weight = level_weight::power;
-    double weight_exponent = 2.0; ///< p of level_weight::power
-    level_interpolation interpolation = level_interpolation::linear;
+    level_weight weight = level_weight::log;
+    double weight_exponent = 2.0; ///< p of level_weight::power (unused by the others)
+    level_interpolation interpolation = level_interpolation::geometric;
 
     /// The textbook lookup: textureLod(chain, R, lod(r)) under the bake's mapping.
     static constexpr specular_lookup_desc textbook(roughness_mapping m = roughness_mapping::linear) noexcept {
