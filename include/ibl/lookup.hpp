@@ -19,6 +19,8 @@
 //                         r^4, while near it the peak ~ 1 / alpha^2 falls steeply; a blend that is
 //                         linear in r overweights the sharper level everywhere in between. The
 //                         exponent that minimises the blend error is measured (docs/lookup.md).
+//   level_weight::log     t = log(r / r_l) / log(r_{l+1} / r_l)  (the lod fraction below level 1,
+//                         where r_0 = 0)
 // and then interpolates across levels by
 //   level_interpolation::linear       (1 - t) L_l + t L_{l+1}: two bilinear taps, i.e. ONE
 //                                     trilinear textureLod(chain, R, l + t) on a GPU;
@@ -27,6 +29,9 @@
 //                                     four bilinear taps (textureLod at the four integer lods).
 //                                     Its weights can be negative: the result is clamped to >= 0
 //                                     per channel.
+//   level_interpolation::geometric    L_l^(1 - t) L_{l+1}^t per channel (linear where either is
+//                                     <= 0): two taps at integer lods. With level_weight::log it
+//                                     is exact where LD is a power law in r (the default).
 // Both reproduce a level exactly at its own roughness (t = 0 gives weight 1 on level l, 0 on the
 // others; the interpolation is written so that the weights are exactly 1 and 0 there), and both
 // reproduce a constant environment exactly (the weights sum to 1).
