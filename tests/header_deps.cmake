@@ -11,6 +11,8 @@
 #   ibl/sh.hpp        core/ sh/ env/cube_geometry.hpp   (no integrate/, batch/: no prefilter code)
 #   ibl/shade.hpp     core/ brdf/                       (takes products as values, bakes nothing)
 #   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
+#   ibl/lookup.hpp    core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp (runtime lookups: no
+#                     integrator, no DFG table code; tables are read through their members)
 #   ibl/batch.hpp     core/ brdf/ sampling/ env/ batch/ (kernels; never integrate/, which calls them)
 #   ibl/batch/**.hpp  the same, for every header under batch/ (also one the umbrella leaves out)
 #
@@ -27,6 +29,7 @@ set(rules
     "sh.hpp|core/ sh/ env/cube_geometry.hpp"
     "shade.hpp|core/ brdf/"
     "plan.hpp|core/ integrate/roughness_mip.hpp"
+    "lookup.hpp|core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp"
     "batch.hpp|core/ brdf/ sampling/ env/ batch/"
     "batch/*.hpp|core/ brdf/ sampling/ env/ batch/")
 

@@ -8,6 +8,7 @@
 #include "core/executor.hpp"
 #include "env.hpp"
 #include "integrate.hpp"
+#include "lookup.hpp"
 #include "plan.hpp"
 #include "sampling.hpp"
 #include "shade.hpp"

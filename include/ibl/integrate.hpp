@@ -7,6 +7,7 @@
 #include "integrate/dfg_multiscatter.hpp"
 #include "integrate/env_importance.hpp"
 #include "integrate/irradiance.hpp"
+#include "integrate/lookup_error.hpp"
 #include "integrate/metrics.hpp"
 #include "integrate/prefilter.hpp"
 #include "integrate/radiance_reference.hpp"

@@ -46,6 +46,9 @@
 // Device-callable functions (IBL_FUNC) never throw: they clamp a count to its bound or report
 // failure in their result (documented where they do, e.g. sh_auto_window).
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -112,3 +115,5 @@ inline std::uint64_t work_add(std::uint64_t acc, std::uint64_t a, std::uint64_t 
 
 } // namespace detail
 } // namespace ibl
+
+#endif // IBL_DETAIL_CXX20
