@@ -5,6 +5,8 @@
 
 #include "stages.hpp"
 
+#include "input_guard.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <span>
@@ -77,6 +79,7 @@ public:
             j.key("height").value(src_->height);
             j.key("negative_values_clamped").value(src_->rr.negative_values);
             j.key("max_value").value(src_->rr.max_value);
+            j.key("values_clamped").value(clamped_).key("clamp_bound").value(double(radiance_clamp_bound));
             j.key("read_time_ms").value(read_ms_);
         }
         j.key("method").value("k x k supersampled bake to a cubemap (ibl::bake_cubemap), exact spherical box mips");
@@ -91,7 +94,9 @@ public:
 private:
     void read_input(bake_context& ctx) {
         ctx.prog.begin("read input");
+        check_input_file(ctx.opt.input, input_byte_limit(ctx.opt.max_input_pixels));
         image_rgb32f img = read_latlong(ctx.opt.input, {}, &ctx.src.rr);
+        clamped_ = clamp_radiance(img, ctx.src.rr);
         ctx.src.analytic = false;
         ctx.src.name = ctx.opt.input;
         ctx.src.width = img.width;
@@ -103,6 +108,7 @@ private:
 
     const source_env* src_ = nullptr;
     int size_ = 1, k_ = 1;
+    std::size_t clamped_ = 0; ///< values above radiance_clamp_bound (input_guard.hpp)
     double read_ms_ = 0.0, cube_ms_ = 0.0;
     dvec3 light_{0.0};
     luminance_stats lstats_;
