@@ -365,8 +365,10 @@ TEST_CASE("guard: inputs must be regular files of bounded size") {
         {(s / "huge.exr").string(), "larger than the limit"},
         {(s / "missing.exr").string(), "no such file"},
     };
-    for (const auto& [in, what] : cases) {
-        const result r = run(s, with(tiny, {"--input", in, "--out", out.string()}), {}, 20);
+    for (const auto& c : cases) {
+        const std::string& in = c.first;
+        const std::string& what = c.second;
+        const result r = run(s, with(tiny, {"--input", in, "--out", out.string()}), {}, 10);
         INFO(in, " ", r.err);
         CHECK_FALSE(r.timed_out);
         CHECK(r.status == 1);
@@ -386,7 +388,7 @@ TEST_CASE("guard: inputs must be regular files of bounded size") {
     CHECK(r.status == 1);
     CHECK(has(r.err, "larger than the limit of " + std::to_string((64u << 20) + 32 * 1000)));
     // scene files too
-    const result rs = run(s, with(tiny, {"--scene", "/dev/zero", "--out", out.string()}), {}, 20);
+    const result rs = run(s, with(tiny, {"--scene", "/dev/zero", "--out", out.string()}), {}, 10);
     CHECK_FALSE(rs.timed_out);
     CHECK(rs.status == 1);
     CHECK(has(rs.err, "character device"));
@@ -433,7 +435,9 @@ TEST_CASE("guard: radiance near float's limit is clamped and counted; a black ma
     write_hdr((s / "black.hdr").string(), image_rgb32f(32, 16));
     const std::map<std::string, std::size_t> expected_clamped = {
         {"spot.exr", 3}, {"top.hdr", 32 * 16 * 3}, {"top.exr", 32 * 16 * 3}, {"black.exr", 0}, {"black.hdr", 0}};
-    for (const auto& [name, clamped] : expected_clamped) {
+    for (const auto& e : expected_clamped) {
+        const std::string& name = e.first;
+        const std::size_t clamped = e.second;
         const fs::path out = s / ("out_" + name);
         const result r = run(s, with(tiny, {"--input", (s / name).string(), "--out", out.string()}));
         INFO(name, " ", r.err);
