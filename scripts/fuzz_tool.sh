@@ -52,7 +52,7 @@ for h in scene options; do
         -rss_limit_mb=2048 -artifact_prefix="$OUT/artifacts/$h-" -print_final_stats=1 >"$OUT/fuzz-$h.log" 2>&1
     s=$?
     set -e
-    grep -E '^#[0-9]+ *(INITED|DONE)|ERROR|SUMMARY|stat::number_of_executed_units|stat::average_exec_per_sec|Done' "$OUT/fuzz-$h.log" | tail -12
+    grep -E '(INITED|DONE) +cov|ERROR|SUMMARY|stat::number_of_executed_units|stat::average_exec_per_sec|Done' "$OUT/fuzz-$h.log" | tail -12
     echo "== $h: exit status $s"
     [ "$s" -ne 0 ] && STATUS=$s
 done
