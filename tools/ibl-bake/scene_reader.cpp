@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "input_guard.hpp"
 #include "json_value.hpp"
 
 namespace ibl_bake {
@@ -150,6 +151,11 @@ ibl::scene_description parse_scene(const std::string& text, const std::string& s
 }
 
 ibl::scene_description read_scene(const std::string& path) {
+    try {
+        check_input_file(path, scene_byte_limit);
+    } catch (const image_error& e) {
+        throw scene_error(e.what());
+    }
     std::ifstream in(path, std::ios::binary);
     if (!in) throw scene_error(path + ": cannot open the scene file");
     std::ostringstream ss;

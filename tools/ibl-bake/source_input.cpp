@@ -5,6 +5,7 @@
 #include <span>
 
 #include "cube_layout.hpp"
+#include "input_guard.hpp"
 #include "ktx2.hpp"
 
 namespace ibl_bake {
@@ -18,7 +19,8 @@ bool ends_with(const std::string& s, const std::string& suffix) {
     return tail == suffix;
 }
 
-void set_cube(source_env& src, const cube_faces& faces, const std::string& format) {
+void set_cube(source_env& src, cube_faces faces, const std::string& format) {
+    for (image_rgb32f& f : faces.face) src.values_clamped += clamp_radiance(f, src.rr);
     src.analytic = false;
     src.cube = std::make_unique<ibl::cubemap<float>>(cubemap_from_faces(faces));
     src.width = src.height = faces.size;
@@ -39,7 +41,9 @@ void read_source(const bake_options& opt, source_env& src) {
     const read_options ro = input_read_options(opt);
     const bool faces = opt.input_layout == "faces" || (opt.input_layout == "auto" && opt.input.find("{face}") != std::string::npos);
     const bool ktx2 = opt.input_layout == "ktx2" || (opt.input_layout == "auto" && ends_with(opt.input, ".ktx2"));
+    const std::uint64_t max_bytes = input_byte_limit(opt.max_input_pixels);
     if (faces) {
+        for (const std::string& p : face_paths(opt.input)) check_input_file(p, max_bytes);
         std::array<read_report, 6> reports;
         set_cube(src, read_face_files(opt.input, ro, &reports), "faces");
         src.rr = reports[0];
@@ -49,6 +53,7 @@ void read_source(const bake_options& opt, source_env& src) {
         }
         return;
     }
+    check_input_file(opt.input, max_bytes);
     if (ktx2) {
         const std::vector<unsigned char> bytes = read_file(opt.input);
         set_cube(src, faces_from_ktx2(decode_ktx2_cubemap(bytes, opt.input), 0, opt.input), "ktx2");
@@ -56,6 +61,7 @@ void read_source(const bake_options& opt, source_env& src) {
         return;
     }
     image_rgb32f img = read_image(opt.input, ro, &src.rr);
+    src.values_clamped += clamp_radiance(img, src.rr); // the cube path below finds nothing left to clamp
     const std::optional<layout_choice> choice = parse_layout_choice(opt.input_layout);
     const input_layout layout = resolve_layout(img.width, img.height, choice ? *choice : layout_choice::automatic, opt.input);
     src.analytic = false;

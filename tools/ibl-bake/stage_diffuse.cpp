@@ -49,7 +49,8 @@ template <class F> void accumulate(irradiance_check& c, const std::vector<dvec3>
     for (std::size_t i = 0; i < normals.size(); ++i) {
         const double er = ref[i].x + ref[i].y + ref[i].z;
         const dvec3 es = e_at(normals[i]);
-        const double rel = std::fabs(es.x + es.y + es.z - er) / er;
+        const double d = std::fabs(es.x + es.y + es.z - er);
+        const double rel = d == 0.0 ? 0.0 : d / std::max(er, 1e-30); // 0 / 0 (a black map) is no error
         mean += rel / double(normals.size());
         max = std::max(max, rel);
     }

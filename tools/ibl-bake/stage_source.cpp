@@ -6,6 +6,7 @@
 #include "stages.hpp"
 
 #include "source_input.hpp"
+#include "input_guard.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -77,6 +78,7 @@ public:
             j.key("height").value(src_->height);
             j.key("negative_values_clamped").value(src_->rr.negative_values);
             j.key("max_value").value(src_->rr.max_value);
+            j.key("values_clamped").value(src_->values_clamped).key("clamp_bound").value(double(radiance_clamp_bound));
             j.key("read_time_ms").value(read_ms_);
         }
         j.key("method").value("k x k supersampled bake to a cubemap (ibl::bake_cubemap), exact spherical box mips");
