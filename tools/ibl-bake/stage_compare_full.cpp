@@ -253,7 +253,8 @@ void compare_full_stage::check_split_sum(bake_context& ctx) {
         ibl::radiance_reference_options ro;
         ro.samples = 1u << 14;
         split_row row{m.name, pm.roughness, 0.0, 0.0};
-        for (const auto& [n, v] : views) {
+        for (const auto& view : views) {
+            const dvec3 n = view.first, v = view.second; // named copies: clang 14 lambdas cannot capture bindings
             const ibl::radiance_estimate ref = ctx.src.visit(
                 [&](const auto& env) { return ibl::reference_radiance<bake_model>(env, dist, n, v, rm, ro, ctx.ex); });
             ibl::ibl_sample<double> s = conv_.view.sample(n, v, pm.roughness);
