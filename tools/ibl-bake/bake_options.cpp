@@ -97,6 +97,12 @@ const std::map<std::string, option_spec>& option_table() {
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
+        {"--dfg-layout", {true, [](bake_options& o, const std::string& v) {
+             o.dfg_layout = choice("--dfg-layout", v, {"remapped", "uniform"});
+         }}},
+        {"--specular-lookup", {true, [](bake_options& o, const std::string& v) {
+             o.specular_lookup = choice("--specular-lookup", v, {"default", "textbook"});
+         }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
@@ -196,6 +202,8 @@ std::string usage_text() {
            "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
            "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
            "  --quiet            no progress on stderr\n"
+           "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
+           "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
            "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"

@@ -21,6 +21,8 @@
 //   --ktx2-format F     rgba16f = f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | rgba32f = f32 |
 //                       b10g11r11 (VK_FORMAT_B10G11R11_UFLOAT_PACK32) | e5b9g9r9 (..._E5B9G9R9_UFLOAT_PACK32)
 //   --quiet             no progress output on stderr
+//   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
+//   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
@@ -60,6 +62,8 @@ struct bake_options {
     bool quiet = false;
     bool help = false;
     bool version = false;
+    std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
+    std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)

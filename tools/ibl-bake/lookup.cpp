@@ -35,20 +35,7 @@ const json_value& member(const json_value& v, const char* key, const std::string
     return *m;
 }
 
-ibl::cubemap<float> cube_from_ktx2(const std::string& path) {
-    const std::vector<unsigned char> bytes = read_file(path);
-    const cubemap_rgb32f k = decode_ktx2_cubemap(bytes, path);
-    ibl::cubemap<float> c(k.size, int(k.levels.size()));
-    for (int l = 0; l < c.levels(); ++l) {
-        const int s = k.face_size(l);
-        c.fill(l, [&](int f, int x, int y) {
-            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
-            return fvec3(t[0], t[1], t[2]);
-        });
-    }
-    c.update_borders();
-    return c;
-}
+ibl::cubemap<float> cube_from_ktx2(const std::string& path) { return cube_from_ktx2_bytes(read_file(path), path); }
 
 ibl::dfg_lut lut_from_exr(const std::string& path, int channels) {
     const image_rgb32f img = read_image(path);
@@ -122,7 +109,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
     if (word == "dfg") {
         need(2);
         if (!b.has_lut) throw std::invalid_argument("the bake has no DFG table");
-        const fvec3 ab = b.lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1])));
+        const fvec3 ab = ibl::dfg_lookup(b.lut, float(unit_interval(a[0])), float(unit_interval(a[1])), b.dfg_layout);
         return fmt9(ab.x) + " " + fmt9(ab.y);
     }
     if (word == "irradiance") {
@@ -153,6 +140,8 @@ product_view baked_folder::view() const {
     v.first_level = first_level;
     v.lut = has_lut ? &lut : nullptr;
     v.diffuse = &diffuse;
+    v.specular = specular;
+    v.dfg_layout = dfg_layout;
     return v;
 }
 
@@ -167,6 +156,8 @@ baked_folder load_baked_folder(const std::string& dir) {
         b.chain = cube_from_ktx2(dir + "/specular.ktx2");
         b.has_chain = true;
     }
+    b.specular = specular_lookup_named(member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? "textbook" : "default");
+    b.dfg_layout = dfg_layout_named(member(member(rt, "dfg_layout", rp), "edge_aligned", rp).boolean ? "remapped" : "uniform");
     if (member(rt, "dfg_size", rp).number > 0) {
         b.lut = lut_from_exr(dir + "/dfg.exr", int(member(rt, "dfg_channels", rp).number));
         b.has_lut = true;

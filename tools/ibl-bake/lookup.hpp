@@ -32,6 +32,8 @@ struct baked_folder {
     bool has_lut = false;
     diffuse_data diffuse;
     int virtual_levels = 1, first_level = 0;
+    ibl::specular_lookup_desc specular{};
+    ibl::dfg_lut_layout dfg_layout{};
 
     product_view view() const;
 };

@@ -23,16 +23,23 @@ dvec3 diffuse_data::irradiance_over_pi(const dvec3& n) const {
     return dvec3(0.0);
 }
 
+dvec3 product_view::ld(const dvec3& r_dir, double roughness) const {
+    if (!chain) return dvec3(0.0);
+    const ibl::specular_taps<float> t = ibl::specular_lookup_taps(float(roughness), virtual_levels, specular);
+    fvec3 v[4];
+    for (int k = 0; k < t.count; ++k) {
+        const int stored = std::clamp(t.level[k] - first_level, 0, chain->levels() - 1);
+        v[k] = t.weight[k] != 0.0f || k == 0 ? chain->bilinear(fvec3(r_dir), stored) : fvec3(0.0f);
+    }
+    return dvec3(ibl::specular_blend(t, v, specular));
+}
+
 ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
     const double n_dot_v = std::clamp(glm::dot(n, v), 0.0, 1.0);
-    const dvec3 r = 2.0 * glm::dot(n, v) * n - v;
     ibl::ibl_sample<double> s;
-    if (chain) {
-        const float lod = policy.lod(float(roughness), virtual_levels) - float(first_level);
-        s.ld = dvec3(chain->radiance(fvec3(r), std::max(lod, 0.0f)));
-    }
+    s.ld = ld(2.0 * glm::dot(n, v) * n - v, roughness);
     if (lut) {
-        const fvec3 ab = lut->sample(float(n_dot_v), float(roughness));
+        const fvec3 ab = ibl::dfg_lookup(*lut, float(n_dot_v), float(roughness), dfg_layout);
         s.dfg = ibl::vec2<double>(ab.x, ab.y);
     } else {
         s.dfg = ibl::dfg_exact<bake_model>(n_dot_v, roughness);
@@ -41,8 +48,43 @@ ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, dou
     return s;
 }
 
+ibl::dfg_lut_layout dfg_layout_named(const std::string& name) {
+    return name == "uniform" ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout{};
+}
+
+ibl::specular_lookup_desc specular_lookup_named(const std::string& name) {
+    return name == "textbook" ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc{};
+}
+
+namespace {
+const char* axis_name(ibl::dfg_axis a) {
+    return a == ibl::dfg_axis::cbrt ? "cbrt" : a == ibl::dfg_axis::sqrt ? "sqrt" : "linear";
+}
+} // namespace
+
+void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d) {
+    j.key("specular_lookup").begin_object();
+    const bool textbook = s.weight == ibl::level_weight::lod;
+    j.key("name").value(textbook ? "textbook" : "log-geometric");
+    j.key("weight").value(textbook ? "lod" : "log");
+    j.key("interpolation").value(textbook ? "linear" : "geometric");
+    j.key("rule").value(textbook ? "textureLod(chain, R, lod(r)): lerp of levels l, l+1 at t = frac(lod)"
+                                 : "levels l, l+1 bracketing r; t linear in log r between their roughness; "
+                                   "L = L_l^(1-t) L_{l+1}^t per channel (ibl/lookup.hpp)");
+    j.end_object();
+    j.key("dfg_layout").begin_object();
+    j.key("n_dot_v").value(axis_name(d.n_dot_v)).key("roughness").value(axis_name(d.roughness));
+    j.key("edge_aligned").value(d.edge_aligned);
+    j.key("rule").value(d.edge_aligned ? "texel i holds axis value f^-1(i / (N - 1)), f = the axis map; sample at "
+                                         "s = (f(x) (N - 1) + 0.5) / N (ibl::dfg_lut_coord)"
+                                       : "texel i holds (i + 0.5) / N; sample at (n.v, r) with clamp to edge");
+    j.end_object();
+}
+
 product_view baked_view(const bake_context& ctx) {
     product_view v;
+    v.specular = specular_lookup_named(ctx.opt.specular_lookup);
+    v.dfg_layout = dfg_layout_named(ctx.opt.dfg_layout);
     v.chain = ctx.chain ? &*ctx.chain : nullptr;
     v.policy = ctx.plan.specular.policy;
     v.virtual_levels = ctx.plan.specular.virtual_levels;
@@ -110,6 +152,20 @@ cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& c) {
                 }
     }
     return k;
+}
+
+ibl::cubemap<float> cube_from_ktx2_bytes(const std::vector<unsigned char>& bytes, const std::string& name) {
+    const cubemap_rgb32f k = decode_ktx2_cubemap(bytes, name);
+    ibl::cubemap<float> c(k.size, int(k.levels.size()));
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        c.fill(l, [&](int f, int x, int y) {
+            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+            return fvec3(t[0], t[1], t[2]);
+        });
+    }
+    c.update_borders();
+    return c;
 }
 
 void write_text(const std::string& path, const std::string& text) {

@@ -1,6 +1,11 @@
 // tools/ibl-bake/stage_dfg.cpp — the split-sum DFG table of the plan's size and channels by exact
-// quadrature (ibl::make_dfg_lut_exact): A, B and, with 3 channels, the multiscatter k = (1 - E)/E.
-// Check: a 16 x 16 grid of texels (fewer for a smaller table) against ibl::dfg_exact.
+// quadrature (ibl::make_dfg_lut_exact) in the table layout of --dfg-layout (ibl/lookup.hpp; the
+// default puts texels in cbrt(n.v) and sqrt(r), edge-aligned): A, B and, with 3 channels, the
+// multiscatter k = (1 - E)/E. Checks: a 16 x 16 grid of texels (fewer for a smaller table) against
+// ibl::dfg_exact at the texels' own (n.v, r); and the lookup a shader makes (ibl::dfg_lookup,
+// bilinear) at points between the texels: n.v at 0, 1 and 33 uniform plus 33 quadratic steps
+// (dense near grazing) x 24 roughness values in [0.05, 1], against dfg_exact; the same for the
+// table rounded to half floats (a 16-bit texture).
 
 #include "stages.hpp"
 
@@ -9,6 +14,7 @@
 
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/dfg_export.hpp>
+#include <ibl/integrate/lookup_error.hpp>
 
 namespace ibl_bake {
 
@@ -28,19 +34,28 @@ public:
         nodes_ = ctx.qs.dfg_nodes;
         quality_ = ctx.qs.name;
         ctx.prog.begin("dfg lut");
-        ctx.lut = ibl::make_dfg_lut_exact<bake_model>(std::uint32_t(ctx.plan.dfg.size), std::uint32_t(ctx.plan.dfg.channels),
-                                                      nodes_, ctx.ex);
+        layout_ = dfg_layout_named(ctx.opt.dfg_layout);
+        ctx.lut = ibl::make_dfg_lut_exact<bake_model>(std::uint32_t(ctx.plan.dfg.size), layout_,
+                                                      std::uint32_t(ctx.plan.dfg.channels), nodes_, ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lut;
         ctx.prog.begin("check dfg");
         check(ctx.ex);
+        const ibl::dfg_error_grid grid = ibl::dfg_error_grid::dense(33, 24, 0.05);
+        const std::vector<ibl::vec2<double>> exact = ibl::dfg_exact_grid<bake_model>(grid, ctx.ex);
+        lookup_ = ibl::dfg_lookup_error(*lut_, layout_, grid, exact);
+        lookup_half_ = ibl::dfg_lookup_error(ibl::quantize_half_lut(*lut_), layout_, grid, exact);
         check_ms_ = ctx.prog.end();
     }
 
     std::vector<table_row> rows() const override {
         return {{"dfg lut", std::string("quadrature, ") + bake_model::name,
                  std::to_string(lut_->size) + "^2, " + std::to_string(nodes_.evaluations()) + " evals/texel", ms_,
-                 fmt("max abs %.3g vs dfg_exact", max_abs_)}};
+                 fmt("max abs %.3g vs dfg_exact", max_abs_)},
+                {"  dfg lookup", std::string("bilinear, ") + (layout_.edge_aligned ? "remapped layout" : "uniform layout"),
+                 std::to_string(lookup_.count) + " points, r >= 0.05", -1.0,
+                 fmt2("max abs %.3g (half %.3g)", lookup_.max_abs, lookup_half_.max_abs) +
+                     fmt2(" at n.v %.3g r %.3g", lookup_.worst_n_dot_v, lookup_.worst_roughness)}};
     }
     std::vector<file_out> files() const override;
     void report(json_writer& j) const override;
@@ -53,7 +68,9 @@ private:
             for (std::size_t k = b; k < e; ++k) {
                 const auto i = std::uint32_t((double(k % std::size_t(gd)) + 0.5) * n / gd);
                 const auto j = std::uint32_t((double(k / std::size_t(gd)) + 0.5) * n / gd);
-                const ibl::vec2<double> ref = ibl::dfg_exact<bake_model>(lut_->n_dot_v(i), lut_->roughness(j));
+                const double nv = ibl::dfg_texel_value<double>(layout_.n_dot_v, i, std::uint32_t(n), layout_.edge_aligned);
+                const double r = ibl::dfg_texel_value<double>(layout_.roughness, j, std::uint32_t(n), layout_.edge_aligned);
+                const ibl::vec2<double> ref = ibl::dfg_exact<bake_model>(nv, r);
                 err[k] = std::max(std::fabs(double(lut_->at(i, j, 0)) - ref.x), std::fabs(double(lut_->at(i, j, 1)) - ref.y));
             }
         });
@@ -62,6 +79,8 @@ private:
     }
 
     const ibl::dfg_lut* lut_ = nullptr;
+    ibl::dfg_lut_layout layout_{};
+    ibl::dfg_lookup_report lookup_, lookup_half_;
     ibl::dfg_quadrature_nodes nodes_{};
     std::string quality_;
     double ms_ = 0.0, check_ms_ = 0.0, max_abs_ = 0.0;
@@ -80,7 +99,10 @@ std::vector<file_out> dfg_stage::files() const {
             {"dfg.hpp", [this](const std::string& p) {
                  write_text(p, ibl::dfg_lut_header(*lut_, "dfg_lut", "ibl_baked",
                                                    std::string(bake_model::name) + ", exact quadrature (ibl-bake --quality " +
-                                                       quality_ + ")"));
+                                                       quality_ + "), layout " +
+                                                       (layout_.edge_aligned ? "cbrt(n.v) x sqrt(r), edge-aligned: sample at "
+                                                                               "ibl::dfg_lut_coord"
+                                                                             : "uniform, texel centres")));
              }}};
 }
 
@@ -98,13 +120,29 @@ void dfg_stage::report(json_writer& j) const {
     j.key("evaluations_per_texel").value(nodes_.evaluations());
     j.end_object();
     j.key("time_ms").value(ms_);
-    j.key("layout").value("x = n.v = (i + 0.5)/N, y = roughness = (j + 0.5)/N (texel centres); EXR row 0 (top) = "
-                          "roughness 0.5/N, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)");
+    j.key("layout").value(layout_.edge_aligned
+                              ? "x: n.v = (i / (N - 1))^3, y: roughness = (j / (N - 1))^2 (edge-aligned; ibl::dfg_lut_layout{}); EXR row 0 "
+                                "(top) = roughness 0, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)"
+                              : "x = n.v = (i + 0.5)/N, y = roughness = (j + 0.5)/N (texel centres); EXR row 0 (top) = "
+                                "roughness 0.5/N, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)");
     j.key("check").begin_object();
     j.key("reference").value("ibl::dfg_exact (default nodes, converged to 1e-6)");
     j.key("texels").value(checked_);
     j.key("max_abs").value(max_abs_);
     j.key("time_ms").value(check_ms_);
+    j.end_object();
+    auto lookup_json = [&](const char* key, const ibl::dfg_lookup_report& r) {
+        j.key(key).begin_object();
+        j.key("points").value(r.count).key("max_abs").value(r.max_abs).key("max_abs_a").value(r.max_abs_a);
+        j.key("max_abs_b").value(r.max_abs_b).key("rms").value(r.rms);
+        j.key("worst_n_dot_v").value(r.worst_n_dot_v).key("worst_roughness").value(r.worst_roughness);
+        j.end_object();
+    };
+    j.key("lookup_check").begin_object();
+    j.key("method").value("ibl::dfg_lookup (bilinear, the table's layout) against ibl::dfg_exact at n.v in {k/32, (k/32)^2}, "
+                          "r in [0.05, 1] (24 values)");
+    lookup_json("float", lookup_);
+    lookup_json("half", lookup_half_);
     j.end_object();
     j.end_object();
 }

@@ -95,6 +95,8 @@ public:
         scene_file_ = ctx.opt.scene;
         scene_name_ = ctx.scene.name;
         levels_ = ctx.set.levels;
+        specular_lookup_ = ctx.opt.specular_lookup;
+        dfg_layout_ = ctx.opt.dfg_layout;
     }
 
     std::vector<table_row> rows() const override { return {}; }
@@ -109,7 +111,7 @@ private:
     ibl::bake_plan plan_, full_;
     ibl::plan_cost est_, est_full_;
     std::vector<std::string> omitted_;
-    std::string scene_file_, scene_name_;
+    std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_;
     int levels_ = 1;
 };
 
@@ -160,6 +162,7 @@ void plan_stage::report(json_writer& j) const {
     j.key("sh_bands").value(plan_.diffuse.sh_bands);
     j.key("dfg_size").value(plan_.dfg.size);
     j.key("dfg_channels").value(plan_.dfg.channels);
+    json_lookup_conventions(j, specular_lookup_named(specular_lookup_), dfg_layout_named(dfg_layout_));
     j.end_object();
     j.key("products");
     plan_json(j, plan_, est_);

@@ -8,6 +8,7 @@
 //   sh            SH projection of the source cube (the plan's bands), window, irradiance
 //   irradiance    irradiance cubemap (when the plan chooses a map over SH)
 //   dfg           the split-sum DFG table by exact quadrature
+//   lookup        check: the chain where a renderer samples it (between levels), vs exact LD
 //   split_sum     check: the baked products through the runtime model against the full integral
 //   preview       check: a sphere grid rendered from the baked products
 //   compare_full  check (--scene --compare-full): full and converged bakes, the plan's error
@@ -19,6 +20,7 @@
 
 #include <ibl/brdf/model.hpp>
 #include <ibl/integrate/roughness_mip.hpp>
+#include <ibl/lookup.hpp>
 #include <ibl/shade.hpp>
 
 #include "ktx2.hpp"
@@ -32,6 +34,7 @@ std::unique_ptr<stage> make_specular_stage();
 std::unique_ptr<stage> make_sh_stage();
 std::unique_ptr<stage> make_irradiance_stage();
 std::unique_ptr<stage> make_dfg_stage();
+std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
 std::unique_ptr<stage> make_preview_stage();
 std::unique_ptr<stage> make_compare_full_stage();
@@ -49,18 +52,29 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// The products as a renderer samples them: the chain at lod = policy(r) over the virtual chain
-/// minus the first stored level (clamped at 0), trilinearly; the DFG table bilinearly (or dfg_exact
-/// when there is none); the diffuse product (or `irradiance_over_pi` when given).
+/// The products as a renderer samples them (ibl/lookup.hpp): the chain by the lookup `specular`
+/// (its taps over the virtual chain, minus the first stored level, clamped to the stored levels),
+/// the DFG table by ibl::dfg_lookup in its layout (or dfg_exact when there is none), the diffuse
+/// product.
 struct product_view {
     const ibl::cubemap<float>* chain = nullptr;
     ibl::roughness_mip_policy policy{};
     int virtual_levels = 1, first_level = 0;
     const ibl::dfg_lut* lut = nullptr;
     const diffuse_data* diffuse = nullptr;
+    ibl::specular_lookup_desc specular{};
+    ibl::dfg_lut_layout dfg_layout{};
 
+    /// LD at reflection direction r_dir and roughness.
+    dvec3 ld(const dvec3& r_dir, double roughness) const;
     ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
 };
+
+/// The DFG table layout and the specular lookup named by --dfg-layout / --specular-lookup.
+ibl::dfg_lut_layout dfg_layout_named(const std::string& name);
+ibl::specular_lookup_desc specular_lookup_named(const std::string& name);
+/// Their description in report.json.
+void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d);
 
 /// The products of ctx as a renderer samples them.
 product_view baked_view(const bake_context& ctx);
@@ -101,6 +115,9 @@ ktx2_format ktx2_format_named(const std::string& name);
 /// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.
 void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
+
+/// A KTX2 cubemap (any format ibl-bake writes) as an ibl::cubemap<float> with valid borders.
+ibl::cubemap<float> cube_from_ktx2_bytes(const std::vector<unsigned char>& bytes, const std::string& name);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
 void json_triples(json_writer& j, const sh3& c, int count);

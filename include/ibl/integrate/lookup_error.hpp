@@ -129,6 +129,14 @@ dfg_lut make_dfg_lut_exact(std::uint32_t size, const dfg_lut_layout& layout, std
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {
             const double r = dfg_texel_value<double>(layout.roughness, std::uint32_t(j), size, layout.edge_aligned);
+            if (r <= 0.0) { // the mirror row of an edge-aligned table: the r -> 0 limit in closed form,
+                            // E = 1 and B = (1 - n.v)^5 (the quadrature degenerates at n.v = r = 0)
+                for (std::uint32_t i = 0; i < size; ++i) {
+                    const double w = pow5(1.0 - mu_of(i));
+                    detail::dfg_store<double>(lut, i, std::uint32_t(j), 1.0, w);
+                }
+                continue;
+            }
             std::uint32_t i = 0;
             for (; i + W <= size; i += W) {
                 double mu[W], e[W], b[W];
