@@ -1,0 +1,185 @@
+// tools/ibl-bake/tests/test_lookup_mode.cpp — `ibl-bake --lookup DIR` answers as the library's
+// runtime functions do on the files of DIR. A tiny bake is made; the test loads its files itself
+// (specular.ktx2 decoded to an ibl::cubemap, dfg.exr to an ibl::dfg_lut, sh.json's shader
+// coefficients) and evaluates ibl::specular_lookup, ibl::dfg_lookup, ibl::sh_shader_evaluate and
+// pbr_shader::ambient (multiple scattering) at the same queries; every answer must agree to float
+// precision (relative 2e-6, about 16 float ulps: the answers are printed with 9 digits). Malformed
+// queries get an error line each and exit status 1; comments and blank lines get no answer.
+
+#include <doctest/doctest.h>
+
+#include "image_io.hpp"
+#include "json_value.hpp"
+#include "ktx2.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <ibl/integrate/dfg_lut.hpp>
+#include <ibl/lookup.hpp>
+#include <ibl/sh/convolve.hpp>
+#include <ibl/shade.hpp>
+
+namespace fs = std::filesystem;
+using namespace ibl_bake;
+using dvec3 = ibl::vec3<double>;
+using fvec3 = ibl::vec3<float>;
+
+namespace {
+
+const std::string tool = IBL_BAKE_TOOL;
+
+std::string slurp(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+struct scratch {
+    fs::path path;
+    scratch() : path(fs::temp_directory_path() / ("ibl_bake_lookup_tests_" + std::to_string(::getpid()))) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~scratch() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    std::string operator/(const std::string& n) const { return (path / n).string(); }
+};
+
+int sh(const std::string& cmd) {
+    const int st = std::system(cmd.c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+ibl::cubemap<float> load_chain(const std::string& path) {
+    const std::string b = slurp(path);
+    const cubemap_rgb32f k = decode_ktx2_cubemap(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(b.data()), b.size()));
+    ibl::cubemap<float> c(k.size, int(k.levels.size()));
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        c.fill(l, [&](int f, int x, int y) {
+            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+            return fvec3(t[0], t[1], t[2]);
+        });
+    }
+    c.update_borders();
+    return c;
+}
+
+ibl::dfg_lut load_lut(const std::string& path) {
+    const image_rgb32f img = read_image(path);
+    ibl::dfg_lut lut{std::uint32_t(img.width), 3, {}};
+    for (int j = 0; j < img.height; ++j)
+        for (int i = 0; i < img.width; ++i)
+            for (int c = 0; c < 3; ++c) lut.data.push_back(img.texel(i, j)[c]);
+    return lut;
+}
+
+ibl::sh_coeffs<double, 3> load_sh(const std::string& path) {
+    const ibl_examples::json_value v = ibl_examples::parse_json(slurp(path));
+    ibl::sh_coeffs<double, 3> k{};
+    const auto& a = v.find("irradiance_over_pi_shader")->values;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        for (int c = 0; c < 3; ++c) k[int(i)][c] = a[i].values[std::size_t(c)].number;
+    return k;
+}
+
+std::vector<double> numbers(const std::string& line) {
+    std::istringstream s(line);
+    std::vector<double> v;
+    double x;
+    while (s >> x) v.push_back(x);
+    return v;
+}
+
+void check_close(const std::vector<double>& got, const std::vector<double>& want) {
+    REQUIRE(got.size() == want.size());
+    for (std::size_t i = 0; i < got.size(); ++i) CHECK(std::fabs(got[i] - want[i]) <= 2e-6 * std::fabs(want[i]) + 1e-12);
+}
+
+} // namespace
+
+TEST_CASE("lookup: answers equal the library's runtime functions on the bake's files") {
+    scratch s;
+    REQUIRE(sh(tool + " --quiet --size 16 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
+    const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
+    const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
+    const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
+    const ibl::specular_lookup_desc sd{};
+    const ibl::dfg_lut_layout layout{};
+
+    std::vector<std::string> q;
+    std::vector<std::vector<double>> want;
+    for (int k = 0; k < 24; ++k) {
+        const double t = 0.37 * k + 0.1, p = 0.91 * k;
+        const dvec3 d = glm::normalize(dvec3(std::cos(t) * std::sin(p), std::cos(p), std::sin(t) * std::sin(p) + 0.01));
+        const double r = std::fmod(0.043 * k, 1.0), nv = std::fmod(0.071 * k + 0.003, 1.0);
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "specular %.17g %.17g %.17g %.17g", d.x, d.y, d.z, r);
+        q.push_back(buf);
+        const fvec3 ld = ibl::specular_lookup(chain, fvec3(d), float(r), sd);
+        want.push_back({ld.x, ld.y, ld.z});
+        std::snprintf(buf, sizeof buf, "dfg %.17g %.17g", nv, r);
+        q.push_back(buf);
+        const fvec3 ab = ibl::dfg_lookup(lut, float(nv), float(r), layout);
+        want.push_back({ab.x, ab.y});
+        std::snprintf(buf, sizeof buf, "irradiance %.17g %.17g %.17g", d.x, d.y, d.z);
+        q.push_back(buf);
+        const dvec3 e = ibl::pi_v<double> * glm::max(ibl::sh_shader_evaluate(shc, d), dvec3(0.0));
+        want.push_back({e.x, e.y, e.z});
+        // shade: view v in the plane of n and +Y
+        const dvec3 v = glm::normalize(d + dvec3(0.3, 0.8, -0.2));
+        std::snprintf(buf, sizeof buf, "shade %.17g %.17g %.17g %.17g %.17g %.17g %.17g %g 0.9 0.6 0.5", d.x, d.y, d.z, v.x, v.y, v.z, r,
+                      k % 2 ? 1.0 : 0.0);
+        q.push_back(buf);
+        ibl::pbr_material<double> m;
+        m.roughness = r;
+        m.metallic = k % 2 ? 1.0 : 0.0;
+        m.base_color = dvec3(0.9, 0.6, 0.5);
+        ibl::ibl_sample<double> smp;
+        const double ndv = std::clamp(glm::dot(d, v), 0.0, 1.0);
+        smp.ld = dvec3(ibl::specular_lookup(chain, fvec3(2.0 * glm::dot(d, v) * d - v), float(r), sd));
+        const fvec3 ab2 = ibl::dfg_lookup(lut, float(ndv), float(r), layout);
+        smp.dfg = ibl::vec2<double>(ab2.x, ab2.y);
+        smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, d), dvec3(0.0));
+        const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
+        want.push_back({lo.x, lo.y, lo.z});
+    }
+    std::ofstream(s / "queries.txt") << "# a comment\n\n" << [&] {
+        std::string all;
+        for (const auto& x : q) all += x + "\n";
+        return all;
+    }();
+    REQUIRE(sh(tool + " --lookup " + (s / "bake") + " < " + (s / "queries.txt") + " > " + (s / "answers.txt")) == 0);
+    std::istringstream answers(slurp(s / "answers.txt"));
+    std::string line;
+    std::size_t n = 0;
+    while (std::getline(answers, line)) {
+        REQUIRE(n < want.size());
+        INFO(q[n]);
+        check_close(numbers(line), want[n]);
+        ++n;
+    }
+    CHECK(n == want.size());
+
+    std::ofstream(s / "bad.txt") << "specular 0 1 0\nfoo 1 2\ndfg 0.5 x\nirradiance 0 0 0\ndfg 0.5 0.5\n";
+    CHECK(sh(tool + " --lookup " + (s / "bake") + " < " + (s / "bad.txt") + " > " + (s / "bad_answers.txt")) == 1);
+    const std::string bad = slurp(s / "bad_answers.txt");
+    CHECK(bad.find("error: line 1: 'specular' takes 4 numbers") != std::string::npos);
+    CHECK(bad.find("error: line 2: unknown query 'foo'") != std::string::npos);
+    CHECK(bad.find("error: line 3: expected numbers") != std::string::npos);
+    CHECK(bad.find("error: line 4: the normal is zero") != std::string::npos);
+    CHECK(std::count(bad.begin(), bad.end(), '\n') == 5); // one line per query, the last one answered
+    CHECK(sh(tool + " --lookup " + (s / "nothing") + " < /dev/null > /dev/null 2>&1") == 1);
+}
