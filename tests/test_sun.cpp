@@ -84,8 +84,8 @@ TEST_CASE_TEMPLATE("disk light: cap irradiance matches quadrature at every eleva
             worst = std::max(worst, std::fabs(e - q) / head_on);
         }
         // the reference's midpoint error O((r / 256)^2), plus for float a few ulps of the head-on
-        // value (the rewritten form has no cancellation); 1e-9: the rounding of the reference's 2.6e5 terms
-        CHECK(worst <= 4.0 * sqr(r / 256.0) + (sizeof(T) == 4 ? 2e-6 : 1e-9));
+        // value (the rewritten form has no cancellation); 1e-8: the reference's floor where the horizon clips its cells (measured 3.2e-9 at r = 0.25 deg)
+        CHECK(worst <= 4.0 * sqr(r / 256.0) + (sizeof(T) == 4 ? 2e-6 : 1e-8));
     }
 }
 
