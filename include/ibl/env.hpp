@@ -7,3 +7,4 @@
 #include "env/cubemap.hpp"
 #include "env/environment.hpp"
 #include "env/latlong.hpp"
+#include "env/sun_extract.hpp"

@@ -5,6 +5,7 @@
 #include "integrate/dfg_fit.hpp"
 #include "integrate/dfg_lut.hpp"
 #include "integrate/dfg_multiscatter.hpp"
+#include "integrate/disk_light.hpp"
 #include "integrate/env_importance.hpp"
 #include "integrate/irradiance.hpp"
 #include "integrate/lookup_error.hpp"
