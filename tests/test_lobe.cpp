@@ -49,7 +49,6 @@ double beckmann_d(double cos_theta, double alpha) {
 
 /// A researcher's lobe: Beckmann drawn exactly from D (n.h): tan^2 = -alpha^2 ln(1 - u).
 struct beckmann_lobe {
-    static constexpr const char* name = "beckmann";
     static double alpha(double r) { return std::max(r * r, 1e-4); }
     static dvec3 sample(const dvec2& u, double r) {
         const double a = alpha(r);
