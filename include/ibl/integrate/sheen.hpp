@@ -33,8 +33,10 @@
 // Computed in double. n.v is clamped to [sheen_min_n_dot_v, 1] = [2^-20, 1] (the panel ends at
 // ln(c2) ~ ln(mu / 2) and must stay finite; the albedo changes by O(mu sqrt(k)) between mu = 0 and
 // the clamp), roughness to [0, 1] with alpha clamped at charlie_min_alpha_v<double>.
-// Accuracy (tests/test_sheen.cpp against an independent hp-graded quadrature of the raw integrand):
-// see sheen_lut_default_nodes.
+// Accuracy with the default nodes (tests/test_sheen.cpp, against an independent hp-graded
+// quadrature of the raw integrand at 152 points including the first row and column of a 128^2
+// table): max abs error 1.0e-8 where E <= 1, max relative error 1.0e-8 where E > 1; E(1, r) matches
+// its closed form to 4e-12 relative. 1088 evaluations of g per (n.v, r); 128^2 in 0.18 s serial.
 //
 // Table: make_sheen_lut(size) returns an ibl::dfg_lut with channels = 1 (channel 0 = E) in the DFG
 // layout (texel centres x = n.v = (i + 0.5) / size, y = r = (j + 0.5) / size, row 0 = r = 0.5 /
@@ -178,7 +180,7 @@ template <class T> T sheen_albedo(T n_dot_v, T roughness, sheen_quadrature_nodes
     return T(sheen_quadrature_rule(nodes).albedo(double(n_dot_v), double(roughness)));
 }
 
-/// Node counts used for tables (see the accuracy figures in docs and tests).
+/// Node counts used for tables (the accuracy figures of the header comment).
 inline constexpr sheen_quadrature_nodes sheen_lut_default_nodes{24, 16, 64, 16};
 
 /// The sheen albedo table: channels = 1 (E), DFG layout (header comment), float.
