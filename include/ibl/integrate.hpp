@@ -14,4 +14,5 @@
 #include "integrate/radiance_reference.hpp"
 #include "integrate/reference.hpp"
 #include "integrate/roughness_mip.hpp"
+#include "integrate/sheen.hpp"
 #include "integrate/sphere_convolve.hpp"

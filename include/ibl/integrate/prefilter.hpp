@@ -51,7 +51,8 @@
 // reads; blocked float accumulation).
 //
 // Levels (roughness_mip.hpp): level l of the output holds roughness policy.roughness(l, levels)
-// at face size max(1, base_size >> l). Level 0 is r = 0, not an integral: a copy of the source
+// at face size max(1, base_size >> l). Level 0 is r = 0, not an integral (for the GGX lobe and
+// every lobe whose r = 0 limit is the mirror; sampling/lobe.hpp): a copy of the source
 // (texel for texel when the source is a cubemap of the same face size; otherwise the source's
 // radiance at the output texel centres, read at the lod of the output texel's solid angle).
 //
@@ -86,6 +87,7 @@
 #include "../env/cubemap.hpp"
 #include "../env/environment.hpp"
 #include "../sampling/ggx.hpp"
+#include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
 #include "roughness_mip.hpp"
 #include "sphere_convolve.hpp"
@@ -109,7 +111,8 @@ struct prefilter_options {
     /// level (default_prefilter_samples). Overridden per level by samples_per_level when that is
     /// long enough.
     std::uint32_t samples = 0;
-    /// Samples for level l at index l (index 0 unused); levels beyond its size use `samples`.
+    /// Samples for level l at index l (index 0 is used only by a lobe whose r = 0 limit is not the
+    /// mirror: prefilter<charlie_lobe>); levels beyond its size use `samples`.
     std::vector<std::uint32_t> samples_per_level{};
     /// Filtered importance sampling: lod bias added to 0.5 log2(Omega_s / Omega_0).
     double lod_bias = 0.5;
@@ -136,35 +139,39 @@ inline std::uint32_t default_prefilter_samples(prefilter_method method, int leve
     return doubling_prefilter_samples(method == prefilter_method::importance ? 1024u : 512u, level);
 }
 
-/// The GGX LD sample table for one roughness (N = V = R): N Hammersley samples, n.l weights,
-/// lods from lod_of_solid_angle(Omega_s) (Omega_s = 4 / (N D(h))). Computed in double, stored as S.
-/// samples = 0 is clamped to 1; samples > limits::max_samples throws std::length_error.
-template <class S, class LodFn>
+/// The LD sample table of lobe L (sampling/lobe.hpp; GGX by default) for one roughness
+/// (N = V = R): N Hammersley draws h = L::sample, weights (n.l) L::ld_weight, lods from
+/// lod_of_solid_angle(Omega_s), Omega_s = 1 / (N pdf_l) (GGX: 4 / (N D(h))). Computed in double,
+/// stored as S. samples = 0 is clamped to 1; samples > limits::max_samples throws std::length_error.
+template <class S, class Lobe = ggx_lobe, class LodFn>
+    requires ld_lobe<Lobe>
 sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, LodFn&& lod_of_solid_angle) {
     detail::check_total("make_ld_table", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
-    const double alpha = alpha_from_roughness(roughness);
     sphere_sample_table<S> t;
     t.drawn = n;
     for (std::uint32_t i = 0; i < n; ++i) {
-        const vec3<double> h = sample_ggx_ndf(hammersley<double>(i, n), alpha);
+        const vec3<double> h = Lobe::sample(hammersley<double>(i, n), roughness);
         const double n_dot_l = 2.0 * h.z * h.z - 1.0;
         if (!(n_dot_l > 0.0)) continue;
+        const double w = n_dot_l * Lobe::ld_weight(h, roughness);
+        if (!(w > 0.0)) continue;
         const vec3<double> l(2.0 * h.z * h.x, 2.0 * h.z * h.y, n_dot_l);
-        const double pdf_l = 0.25 * ndf_ggx(h, alpha);
+        const double pdf_l = lobe_ld_pdf<Lobe>(h, roughness);
         const double omega_s = 1.0 / (double(n) * pdf_l);
-        t.push(vec3<S>(l), S(n_dot_l), S(lod_of_solid_angle(omega_s)));
+        t.push(vec3<S>(l), S(w), S(lod_of_solid_angle(omega_s)));
     }
     return t;
 }
 
-/// The LD table of one level for a given source and options (the lod rule of the header comment).
-/// samples > limits::max_samples throws std::length_error.
-template <class S, class Env>
+/// The LD table of lobe L (GGX by default) of one level for a given source and options (the lod
+/// rule of the header comment). samples > limits::max_samples throws std::length_error.
+template <class S, class Lobe = ggx_lobe, class Env>
+    requires ld_lobe<Lobe>
 sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::uint32_t samples,
                                          prefilter_method method, double lod_bias) {
     detail::check_total("make_ld_table_for", "samples", samples, limits::max_samples, "limits::max_samples");
-    return make_ld_table<S>(roughness, samples, [&](double omega_s) -> double {
+    return make_ld_table<S, Lobe>(roughness, samples, [&](double omega_s) -> double {
         if (method == prefilter_method::importance) return 0.0;
         using Te = std::conditional_t<environment<Env, float>, float, double>;
         // The bias b scales the footprint by 4^b: 0.5 log2(4^b Omega_s / Omega_0) = lod + b.
@@ -252,14 +259,18 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 }
 } // namespace detail
 
-/// The prefiltered mip chain of an environment: level l holds LD for roughness
-/// opt.policy.roughness(l, levels) at face size max(1, base >> l). Cubemap sources (with their mip
-/// chain generated) take the fast path; any other environment is evaluated per sample.
+/// The prefiltered mip chain of an environment for lobe L (sampling/lobe.hpp; GGX by default,
+/// prefilter<ibl::charlie_lobe>(env, opt) for sheen): level l holds LD for roughness
+/// opt.policy.roughness(l, levels) at face size max(1, base >> l). Level 0 is the copy of the
+/// source when the lobe's r = 0 limit is the mirror (GGX), else convolved at r = policy.roughness(0)
+/// with the samples of level 0 (prefilter_samples). Cubemap sources (with their mip chain
+/// generated) take the fast path; any other environment is evaluated per sample.
 /// Throws std::invalid_argument for base_size < 0 (or 0 without a source size) and levels < 0,
 /// std::length_error for base_size > limits::max_face_size, a level's samples (opt.samples or
 /// samples_per_level[l]) > limits::max_samples, or a total work sum over levels of
 /// 6 n_l^2 samples_l (x 2 when trilinear) > limits::max_work, before any work.
-template <class Env, class Executor = serial_executor>
+template <class Lobe = ggx_lobe, class Env, class Executor = serial_executor>
+    requires ld_lobe<Lobe>
 cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const int levels = prefilter_levels(opt, base);
@@ -271,11 +282,12 @@ cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Exec
             return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
         });
     };
-    store(0, detail::prefilter_base(env, base, ex));
-    for (int l = 1; l < levels; ++l) {
+    constexpr bool mirror_base = lobe_mirror_limit<Lobe>();
+    if constexpr (mirror_base) store(0, detail::prefilter_base(env, base, ex));
+    for (int l = mirror_base ? 1 : 0; l < levels; ++l) {
         const double r = opt.policy.roughness(double(l), levels);
         sphere_sample_table<float> table =
-            make_ld_table_for<float>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias);
+            make_ld_table_for<float, Lobe>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias);
         table.trilinear = opt.trilinear;
         store(l, convolve_faces(env, table, out.size(l), ex));
     }

@@ -71,6 +71,7 @@
 #include "../env/environment.hpp"
 #include "../sampling/ggx.hpp"
 #include "../sampling/hemisphere.hpp"
+#include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
 
 namespace ibl {
@@ -127,24 +128,27 @@ inline double ggx_ld_normaliser(double alpha) {
     return 4.0 * i_val;
 }
 
-/// LD at unit direction R for perceptual roughness r: GGX importance sampling, n.l weights,
-/// `samples` Hammersley points (0 -> 1), lod 0, double. Any environment.
-/// samples > limits::max_samples throws std::length_error.
-template <class Env> vec3<double> reference_ld(const Env& env, const vec3<double>& dir, double roughness,
-                                               std::uint32_t samples) {
+/// LD at unit direction R for perceptual roughness r of lobe L (sampling/lobe.hpp; GGX by
+/// default): importance sampling with L::sample and weights (n.l) L::ld_weight, `samples`
+/// Hammersley points (0 -> 1), lod 0, double. Any environment. reference_ld<ibl::charlie_lobe>(...)
+/// is the sheen LD. samples > limits::max_samples throws std::length_error.
+template <class Lobe = ggx_lobe, class Env>
+    requires ld_lobe<Lobe>
+vec3<double> reference_ld(const Env& env, const vec3<double>& dir, double roughness, std::uint32_t samples) {
     detail::check_total("reference_ld", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
-    const double alpha = alpha_from_roughness(roughness);
     const frame<double> fr = make_frame(glm::normalize(dir));
     detail::neumaier3 acc;
     neumaier_sum<double> wsum;
     for (std::uint32_t i = 0; i < n; ++i) {
-        const vec3<double> h = sample_ggx_ndf(hammersley<double>(i, n), alpha);
+        const vec3<double> h = Lobe::sample(hammersley<double>(i, n), roughness);
         const double n_dot_l = 2.0 * h.z * h.z - 1.0;
         if (!(n_dot_l > 0.0)) continue;
+        const double w = n_dot_l * Lobe::ld_weight(h, roughness);
+        if (!(w > 0.0)) continue;
         const vec3<double> l = fr.to_world(vec3<double>(2.0 * h.z * h.x, 2.0 * h.z * h.y, n_dot_l));
-        acc.add(n_dot_l * detail::radiance_d(env, l));
-        wsum.add(n_dot_l);
+        acc.add(w * detail::radiance_d(env, l));
+        wsum.add(w);
     }
     const double w = wsum.value();
     return w > 0.0 ? acc.value() / w : vec3<double>(0.0);
