@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <functional>
 #include <initializer_list>
 #include <map>
@@ -97,6 +98,22 @@ const std::map<std::string, option_spec>& option_table() {
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
+        {"--sh-bands", {true, [](bake_options& o, const std::string& v) { o.sh_bands = int(parse_integer("--sh-bands", v, 2, 5)); }}},
+        {"--sh-window", {true, [](bake_options& o, const std::string& v) {
+             if (v != "auto" && v != "none") {
+                 double w = 0.0;
+                 const auto r = std::from_chars(v.data(), v.data() + v.size(), w);
+                 if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !(w > 0.0) || !std::isfinite(w))
+                     throw usage_error("--sh-window: expected auto, none or a width > 0, got '" + v + "'");
+             }
+             o.sh_window = v;
+         }}},
+        {"--irradiance-size", {true, [](bake_options& o, const std::string& v) {
+             o.irradiance_size = int(parse_integer("--irradiance-size", v, 0, 256));
+         }}},
+        {"--extract-sun", {true, [](bake_options& o, const std::string& v) {
+             o.extract_sun = choice("--extract-sun", v, {"auto", "on", "off"});
+         }}},
         {"--dfg-layout", {true, [](bake_options& o, const std::string& v) {
              o.dfg_layout = choice("--dfg-layout", v, {"remapped", "uniform"});
          }}},
@@ -202,6 +219,10 @@ std::string usage_text() {
            "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
            "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
            "  --quiet            no progress on stderr\n"
+           "  --sh-bands B       SH bands 2..5 (default 3)\n"
+           "  --sh-window W      auto (default) | none | Hanning width W: applied to irradiance and shader SH\n"
+           "  --irradiance-size N  irradiance map face (default 32), 0 = none\n"
+           "  --extract-sun S    auto (default) | on | off: a compact dominant source becomes lights.json\n"
            "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
            "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"

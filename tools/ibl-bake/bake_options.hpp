@@ -21,6 +21,10 @@
 //   --ktx2-format F     rgba16f = f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | rgba32f = f32 |
 //                       b10g11r11 (VK_FORMAT_B10G11R11_UFLOAT_PACK32) | e5b9g9r9 (..._E5B9G9R9_UFLOAT_PACK32)
 //   --quiet             no progress output on stderr
+//   --sh-bands B        SH bands 2..5 (default: 3; a scene plan's 2 or 3)
+//   --sh-window W       auto (default) | none | a Hanning width > 0 (applies to irradiance / shader)
+//   --irradiance-size N irradiance map face 1..256 (default 32), 0 = no map (full bake)
+//   --extract-sun S     auto (default: extract a compact dominant source as a disk light) | on | off
 //   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
 //   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
@@ -62,6 +66,10 @@ struct bake_options {
     bool quiet = false;
     bool help = false;
     bool version = false;
+    int sh_bands = 0;                          ///< --sh-bands 2..5; 0: the plan's (3 in the full bake)
+    std::string sh_window = "auto";            ///< auto | none | a Hanning width W > 0
+    int irradiance_size = 32;                  ///< --irradiance-size: face of the irradiance map (0: none)
+    std::string extract_sun = "auto";          ///< auto | on | off
     std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
     std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)

@@ -24,6 +24,11 @@ namespace {
 
 using ibl_examples::json_value;
 
+bool fs_exists(const std::string& path) {
+    std::ifstream f(path);
+    return bool(f);
+}
+
 std::string slurp(const std::string& path) {
     const std::vector<unsigned char> b = read_file(path);
     return std::string(b.begin(), b.end());
@@ -56,9 +61,10 @@ diffuse_data sh_from_json(const std::string& path) {
     diffuse_data d;
     d.kind = ibl::diffuse_product::sh;
     d.bands = int(member(v, "bands", path).number);
-    const json_value& k = member(v, "irradiance_over_pi_shader", path);
+    const json_value* kw = v.find("irradiance_over_pi_shader_windowed");
+    const json_value& k = kw ? *kw : member(v, "irradiance_over_pi_shader", path);
     const json_value& r = member(v, "radiance", path);
-    if (k.values.size() > 9 || k.values.size() != r.values.size()) throw std::runtime_error(path + ": unexpected coefficient count");
+    if (k.values.size() > 25 || k.values.size() != r.values.size()) throw std::runtime_error(path + ": unexpected coefficient count");
     for (std::size_t i = 0; i < k.values.size(); ++i)
         for (int c = 0; c < 3; ++c) {
             d.shader_over_pi[int(i)][c] = k.values[i].values.at(std::size_t(c)).number;
@@ -104,7 +110,8 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
     if (word == "specular") {
         need(4);
         if (!b.has_chain) throw std::invalid_argument("the bake has no specular chain");
-        return triple(v.sample(unit(a[0], a[1], a[2], "the direction"), unit(a[0], a[1], a[2], "the direction"), unit_interval(a[3])).ld);
+        const dvec3 d = unit(a[0], a[1], a[2], "the direction");
+        return triple(v.ld(d, unit_interval(a[3])) + sun_ld(v.sun, d, unit_interval(a[3])));
     }
     if (word == "dfg") {
         need(2);
@@ -115,7 +122,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
     if (word == "irradiance") {
         need(3);
         if (b.diffuse.kind == ibl::diffuse_product::none) throw std::invalid_argument("the bake has no diffuse product");
-        return triple(ibl::pi_v<double> * b.diffuse.irradiance_over_pi(unit(a[0], a[1], a[2], "the normal")));
+        return triple(v.irradiance(unit(a[0], a[1], a[2], "the normal")));
     }
     if (word == "shade") {
         need(11);
@@ -125,7 +132,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         m.metallic = unit_interval(a[7]);
         m.base_color = glm::clamp(dvec3(a[8], a[9], a[10]), dvec3(0.0), dvec3(1.0));
         const auto shader = ibl::pbr_shader<double>::from(m, true);
-        return triple(shader.ambient(std::clamp(glm::dot(n, vv), 0.0, 1.0), v.sample(n, vv, m.roughness)));
+        return triple(v.shade(shader, n, vv));
     }
     throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade)");
 }
@@ -142,6 +149,7 @@ product_view baked_folder::view() const {
     v.diffuse = &diffuse;
     v.specular = specular;
     v.dfg_layout = dfg_layout;
+    v.sun = sun ? &*sun : nullptr;
     return v;
 }
 
@@ -161,6 +169,16 @@ baked_folder load_baked_folder(const std::string& dir) {
     if (member(rt, "dfg_size", rp).number > 0) {
         b.lut = lut_from_exr(dir + "/dfg.exr", int(member(rt, "dfg_channels", rp).number));
         b.has_lut = true;
+    }
+    if (fs_exists(dir + "/lights.json")) {
+        const json_value lj = ibl_examples::parse_json(slurp(dir + "/lights.json"));
+        for (const json_value& l : member(lj, "lights", dir + "/lights.json").values) {
+            const json_value& d = member(l, "direction", "lights.json");
+            const json_value& rad = member(l, "radiance", "lights.json");
+            b.sun = ibl::disk_light<double>{dvec3(d.values.at(0).number, d.values.at(1).number, d.values.at(2).number),
+                                            member(l, "solid_angle", "lights.json").number,
+                                            dvec3(rad.values.at(0).number, rad.values.at(1).number, rad.values.at(2).number)};
+        }
     }
     const std::string diffuse = member(rt, "diffuse", rp).string;
     if (diffuse == "sh") b.diffuse = sh_from_json(dir + "/sh.json");

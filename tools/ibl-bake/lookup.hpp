@@ -12,6 +12,8 @@
 //                                 pbr_shader ambient, multiple scattering) for normal N, view V
 //                                 (towards the eye; both normalised), roughness R, metallic M,
 //                                 base colour B
+// With a sun in lights.json the answers are about the whole environment: specular adds the sun's
+// exact LD term (ibl::disk_light_ld), irradiance its cap irradiance, shade its disk-light shading.
 // R, NV, M are clamped to [0, 1] as the runtime does. A malformed query (unknown word, wrong count,
 // a non-number, a zero or non-finite direction) gets one line "error: line L: <why>: <the query>"
 // in place of its answer; the exit status is then 1 (0 when every query was answered).
@@ -34,6 +36,7 @@ struct baked_folder {
     int virtual_levels = 1, first_level = 0;
     ibl::specular_lookup_desc specular{};
     ibl::dfg_lut_layout dfg_layout{};
+    std::optional<ibl::disk_light<double>> sun; ///< lights.json's sun, if any
 
     product_view view() const;
 };

@@ -20,6 +20,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     std::vector<std::unique_ptr<stage>> s;
     s.push_back(make_plan_stage());
     s.push_back(make_source_stage());
+    s.push_back(make_sun_stage());
     s.push_back(make_specular_stage());
     s.push_back(make_sh_stage());
     s.push_back(make_irradiance_stage());

@@ -30,6 +30,7 @@
 #include <ibl/integrate/dfg_lut.hpp>
 #include <ibl/plan.hpp>
 #include <ibl/sh/basis.hpp>
+#include <ibl/shade.hpp>
 
 #include "bake_exec.hpp"
 #include "bake_options.hpp"
@@ -42,6 +43,7 @@ namespace ibl_bake {
 using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 using sh3 = ibl::sh_coeffs<double, 3>;
+using sh5 = ibl::sh_coeffs<double, 5>; ///< SH storage of every band count the tool bakes (2..5)
 
 /// The environment the products are baked from: the built-in sky + sun, a lat-long image or a
 /// cube (a cross, six faces or a KTX2 cubemap: source_input.hpp).
@@ -73,9 +75,9 @@ struct luminance_stats {
 /// The diffuse product as a renderer evaluates it.
 struct diffuse_data {
     ibl::diffuse_product kind = ibl::diffuse_product::none;
-    int bands = 0;               ///< SH: 2 or 3 (stored as 3 bands, band 2 zero for 2)
-    sh3 radiance{};              ///< SH radiance after the window, if one was applied
-    sh3 shader_over_pi{};        ///< sh_shader_coeffs(radiance, irradiance_over_pi)
+    int bands = 0;               ///< SH: 2..5 (stored as 5 bands, the bands above zero)
+    sh5 radiance{};              ///< SH radiance after the window, if one was applied
+    sh5 shader_over_pi{};        ///< sh_shader_coeffs(radiance, irradiance_over_pi)
     ibl::cubemap<float> map{1};  ///< irradiance map (E, not E/pi)
 
     /// E(n)/pi as the shader computes it (SH: the polynomial form, clamped at 0).
@@ -110,6 +112,13 @@ struct bake_context {
     ibl::cubemap<float> source{1};
     dvec3 light{0.0, 1.0, 0.0}; ///< direction of the brightest source texel
     luminance_stats lstats;
+
+    // the sun (the sun stage): when extracted, `source` is the residual and `original` the cube
+    // before; every product is of the residual, and the runtime adds the sun as a disk light
+    std::optional<ibl::disk_light<double>> sun;
+    std::optional<ibl::cubemap<float>> original;
+    /// The source before extraction (the environment every full-integral check compares with).
+    const ibl::cubemap<float>& whole_source() const { return original ? *original : source; }
 
     // products (the product stages)
     std::optional<ibl::cubemap<float>> chain; ///< the stored levels of plan.specular

@@ -11,6 +11,7 @@
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/prefilter.hpp>
+#include <ibl/integrate/disk_light.hpp>
 #include <ibl/integrate/reference.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
@@ -32,6 +33,22 @@ dvec3 product_view::ld(const dvec3& r_dir, double roughness) const {
         v[k] = t.weight[k] != 0.0f || k == 0 ? chain->bilinear(fvec3(r_dir), stored) : fvec3(0.0f);
     }
     return dvec3(ibl::specular_blend(t, v, specular));
+}
+
+dvec3 product_view::shade(const ibl::pbr_shader<double>& shader, const dvec3& n, const dvec3& v) const {
+    dvec3 lo = shader.ambient(std::clamp(glm::dot(n, v), 0.0, 1.0), sample(n, v, shader.m.roughness));
+    if (sun) lo += ibl::shade_disk(n, v, *sun, shader.m);
+    return lo;
+}
+
+dvec3 product_view::irradiance(const dvec3& n) const {
+    dvec3 e = diffuse ? ibl::pi_v<double> * diffuse->irradiance_over_pi(n) : dvec3(0.0);
+    if (sun) e += ibl::disk_light_irradiance(n, *sun);
+    return e;
+}
+
+dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness) {
+    return sun ? ibl::disk_light_ld(*sun, d, roughness) : dvec3(0.0);
 }
 
 ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
@@ -91,6 +108,7 @@ product_view baked_view(const bake_context& ctx) {
     v.first_level = ctx.plan.specular.first_level;
     v.lut = ctx.lut ? &*ctx.lut : nullptr;
     v.diffuse = &ctx.diffuse;
+    v.sun = ctx.sun ? &*ctx.sun : nullptr;
     return v;
 }
 
@@ -195,7 +213,7 @@ void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level
     j.end_object();
 }
 
-void json_triples(json_writer& j, const sh3& c, int count) {
+void json_triples(json_writer& j, const sh5& c, int count) {
     j.begin_array();
     for (int k = 0; k < count; ++k) {
         j.begin_array();
@@ -236,8 +254,9 @@ diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex) {
     diffuse_data d;
     d.kind = ibl::diffuse_product::sh;
     d.bands = 3;
-    d.radiance = ibl::project_cube<3>(
+    const sh3 raw = ibl::project_cube<3>(
         src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ex);
+    for (int k = 0; k < 9; ++k) d.radiance[k] = raw[k];
     d.shader_over_pi = ibl::sh_shader_coeffs(d.radiance, ibl::sh_shader_output::irradiance_over_pi);
     return d;
 }

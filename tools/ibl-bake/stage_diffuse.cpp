@@ -1,12 +1,19 @@
 // tools/ibl-bake/stage_diffuse.cpp — the diffuse products.
-//   sh          projection of the source cube onto the plan's SH bands (exact texel solid angles,
-//               ibl::project_cube), Lambert convolution; the full bake applies the weakest Hanning
-//               window that keeps E >= 0 (ibl::sh_auto_window) when the raw irradiance has a
-//               negative minimum; a scene plan keeps the raw projection (its error figures are for
-//               it; the shader clamps E at 0).
-//   irradiance  an irradiance cubemap of the plan's face size (ibl::irradiance_cubemap).
-// Check of both: E at the texel centres of an 8 x 8-per-face cube against the brute-force sum
-// over every texel of the first source level of face <= 128.
+//   sh          projection of the source cube onto B SH bands (--sh-bands 2..5; a scene plan picks
+//               2 or 3; exact texel solid angles, ibl::project_cube), Lambert convolution. sh.json's
+//               "radiance" is always the raw projection. A window (--sh-window) applies to the
+//               irradiance and shader coefficients only, which are then named *_windowed:
+//               auto (default): the weakest Hanning window keeping E >= 0 (ibl::sh_auto_window)
+//               when the raw irradiance's minimum is below -window_threshold (5%) of its mean in
+//               some channel (a negative minimum that matters; a ringing of 1-2% of the mean is
+//               left alone, as the shader clamps E at 0); none; or a Hanning width W.
+//   irradiance  an irradiance cubemap of face --irradiance-size (default 32; a scene plan's map size)
+//               by texel moments over level 0 (ibl::irradiance_texel_moments: exact for blocks
+//               above the horizon). In the full bake beside SH; the runtime's diffuse product.
+// Checks of both: E at the texel centres of an 8 x 8-per-face cube against the brute-force sum
+// over every texel of the first source level of face <= 128; when a sun was extracted, also the
+// runtime's E (the product plus the sun's cap irradiance) against the brute force over the
+// source before extraction (what a renderer gets from the whole environment).
 
 #include "stages.hpp"
 
@@ -15,6 +22,7 @@
 
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/irradiance.hpp>
+#include <functional>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
 #include <ibl/sh/window.hpp>
@@ -58,50 +66,71 @@ template <class F> void accumulate(irradiance_check& c, const std::vector<dvec3>
 }
 
 const char* sh_convention =
-    "Real spherical harmonics, orthonormal over the sphere, without the Condon-Shortley phase, 3 bands "
-    "(9 coefficients, index k = l*l + l + m). Basis on a unit direction (x, y, z) of the world frame: "
+    "Real spherical harmonics, orthonormal over the sphere, without the Condon-Shortley phase, 'bands' bands "
+    "(bands^2 coefficients, index k = l*l + l + m; bands 3 and 4 as include/ibl/sh/basis.hpp). Basis on a unit direction (x, y, z) of the world frame: "
     "Y0 = 0.282095 (1/(2 sqrt(pi))); Y1 = 0.488603 y; Y2 = 0.488603 z; Y3 = 0.488603 x "
     "(sqrt(3/(4 pi))); Y4 = 1.092548 x y; Y5 = 1.092548 y z (sqrt(15/pi)/2); "
     "Y6 = 0.315392 (3 z^2 - 1) (sqrt(5/pi)/4); Y7 = 1.092548 x z; Y8 = 0.546274 (x^2 - y^2) (sqrt(15/pi)/4). "
     "Frame: right-handed, +Y up; lat-long images map direction (x, y, z) to u = 0.5 + atan2(z, x)/(2 pi), "
     "v = 0.5 + asin(y)/pi, with the top image row at +Y (v = 1); cubemap faces +X, -X, +Y, -Y, +Z, -Z in the "
-    "OpenGL orientation. 'radiance' holds L_k = integral L(w) Y_k(w) dw (linear RGB, after the window if one "
-    "was applied); 'irradiance' holds E_k = A_l L_k with A_0 = pi, A_1 = 2 pi/3, A_2 = pi/4, so that "
+    "OpenGL orientation. 'radiance' holds L_k = integral L(w) Y_k(w) dw (linear RGB, always the raw "
+    "projection); 'irradiance' holds E_k = A_l L_k with A_0 = pi, A_1 = 2 pi/3, A_2 = pi/4, "
+    "A_3 = 0, A_4 = -pi/24 (after the window if one was applied: then named 'irradiance_windowed'), so that "
     "E(n) = sum_k E_k Y_k(n) = integral L(w) max(0, n.w) dw; 'irradiance_over_pi_shader' holds c_k = E_k K_k / pi "
     "for the polynomial form E(n)/pi = sum_k c_k p_k(n) with p = (1, y, z, x, x y, y z, 3 z^2 - 1, x z, x^2 - y^2) "
+    "for the first 9 (the higher bands' polynomials as basis.hpp; windowed: 'irradiance_over_pi_shader_windowed') "
     "(multiply by the diffuse albedo for Lambert).";
+
+constexpr double window_threshold = 0.05; ///< auto window: min E below -5% of the mean E
+
+/// The runtime's E against brute force over the whole source, when a sun was extracted.
+void check_with_sun(const bake_context& ctx, const std::vector<dvec3>& normals, irradiance_check& c,
+                    const std::function<dvec3(const dvec3&)>& e_product, double& mean, double& max) {
+    mean = max = 0.0;
+    if (!ctx.sun) return;
+    const ibl::cubemap<float>& whole = ctx.whole_source();
+    const std::vector<dvec3> ref = texel_sum_irradiance(whole, level_at_most(whole, brute_max_face), normals, ctx.ex);
+    accumulate(c, normals, ref, [&](const dvec3& n) { return e_product(n) + ibl::disk_light_irradiance(n, *ctx.sun); }, mean, max);
+}
 
 class sh_stage final : public stage {
 public:
     const char* key() const override { return "sh"; }
     stage_kind kind() const override { return stage_kind::product; }
     const char* category() const override { return "diffuse"; }
-    bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::sh; }
+    bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::sh || !ctx.scene_mode; }
     double product_ms() const override { return ms_; }
 
     void run(bake_context& ctx) override {
-        bands_ = ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
-        auto_window_ = !ctx.scene_mode;
+        bands_ = ctx.opt.sh_bands > 0 ? ctx.opt.sh_bands : ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
+        window_ = ctx.opt.sh_window;
         texels_ = 6 * ctx.source.size(0) * ctx.source.size(0);
         ctx.prog.begin("sh");
-        if (bands_ == 2) project<2>(ctx);
-        else project<3>(ctx);
+        switch (bands_) {
+        case 2: project<2>(ctx); break;
+        case 4: project<4>(ctx); break;
+        case 5: project<5>(ctx); break;
+        default: project<3>(ctx); break;
+        }
         irr_ = ibl::sh_irradiance(rad_);
         shader_ = ibl::sh_shader_coeffs(rad_, ibl::sh_shader_output::irradiance_over_pi);
         ms_ = ctx.prog.end();
-        ctx.diffuse.kind = ibl::diffuse_product::sh;
-        ctx.diffuse.bands = bands_;
-        ctx.diffuse.radiance = rad_;
-        ctx.diffuse.shader_over_pi = shader_;
+        if (ctx.diffuse.kind != ibl::diffuse_product::irradiance_map) { // the runtime's diffuse product
+            ctx.diffuse.kind = ibl::diffuse_product::sh;
+            ctx.diffuse.bands = bands_;
+            ctx.diffuse.radiance = rad_;
+            ctx.diffuse.shader_over_pi = shader_;
+        }
         check(ctx);
     }
 
     std::vector<table_row> rows() const override {
         const std::string method = std::to_string(bands_) + "-band projection, " +
                                    (windowed_ ? fmt("Hanning window W=%.3g", width_) : std::string("no window"));
-        return {{"sh irradiance", method, std::to_string(texels_) + " texels", ms_,
-                 fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel) +
-                     fmt2(", min E %.3g -> %.3g", min3(min_before_), min3(min_after_))}};
+        std::string err = fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel) +
+                          fmt2(", min E %.3g -> %.3g", min3(min_before_), min3(min_after_));
+        if (sun_) err += fmt2("; + sun vs whole: mean rel %.3g, max rel %.3g", sun_mean_, sun_max_);
+        return {{"sh irradiance", method, std::to_string(texels_) + " texels", ms_, err}};
     }
     std::vector<file_out> files() const override {
         return {{"sh.json", [this](const std::string& p) { write_text(p, sh_json()); }}};
@@ -114,25 +143,33 @@ private:
         const ibl::sh_coeffs<double, B> raw = ibl::project_cube<B>(
             src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ctx.ex);
         ibl::sh_coeffs<double, B> rad = raw;
-        if (auto_window_) {
+        min_before_ = min_after_ = ibl::sh_min_irradiance(raw, 4096).value;
+        const dvec3 mean = ibl::sh_irradiance(raw)[0] * 0.282094791773878143; // E_00 Y_00: the mean of E over the sphere
+        bool apply = window_ != "none" && window_ != "auto";
+        if (window_ == "auto")
+            for (int c = 0; c < 3; ++c) apply = apply || min_before_[c] < -window_threshold * mean[c];
+        if (apply && window_ == "auto") {
             const ibl::sh_auto_window_result<double, B> win = ibl::sh_auto_window(raw);
             windowed_ = std::isfinite(win.width);
             width_ = win.width;
-            min_before_ = win.min_before, min_after_ = win.min_after;
             rad = win.radiance;
-        } else {
-            min_before_ = min_after_ = ibl::sh_min_irradiance(raw, 4096).value;
+        } else if (apply) {
+            width_ = std::stod(window_);
+            windowed_ = true;
+            rad = ibl::sh_apply_window(raw, ibl::sh_window_kind::hanning, width_);
         }
+        if (windowed_) min_after_ = ibl::sh_min_irradiance(rad, 4096).value;
         for (int k = 0; k < B * B; ++k) raw_[k] = raw[k], rad_[k] = rad[k];
     }
     void check(bake_context& ctx);
     std::string sh_json() const;
 
     int bands_ = 3, texels_ = 0;
-    bool auto_window_ = true, windowed_ = false;
-    double width_ = 0.0, ms_ = 0.0;
+    std::string window_ = "auto";
+    bool windowed_ = false, sun_ = false;
+    double width_ = 0.0, ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     dvec3 min_before_{0.0}, min_after_{0.0};
-    sh3 raw_{}, rad_{}, irr_{}, shader_{};
+    sh5 raw_{}, rad_{}, irr_{}, shader_{};
     irradiance_check c_;
 };
 
@@ -145,20 +182,24 @@ void sh_stage::check(bake_context& ctx) {
     const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
     accumulate(c_, normals, ref, [&](const dvec3& n) { return ibl::sh_irradiance_at(rad_, n); }, c_.mean_rel, c_.max_rel);
     accumulate(c_, normals, ref, [&](const dvec3& n) { return ibl::sh_irradiance_at(raw_, n); }, c_.mean_rel_raw, c_.max_rel_raw);
+    sun_ = ctx.sun.has_value();
+    check_with_sun(ctx, normals, c_, [&](const dvec3& n) { return glm::max(ibl::sh_irradiance_at(rad_, n), dvec3(0.0)); }, sun_mean_,
+                   sun_max_);
     ctx.prog.end();
     c_.ms = ms_since(t0);
 }
 
 std::string sh_stage::sh_json() const {
     const int count = bands_ * bands_;
+    const std::string suffix = windowed_ ? "_windowed" : "";
     json_writer j;
     j.begin_object();
     j.key("bands").value(bands_);
     j.key("radiance");
-    json_triples(j, rad_, count);
-    j.key("irradiance");
+    json_triples(j, raw_, count);
+    j.key("irradiance" + suffix);
     json_triples(j, irr_, count);
-    j.key("irradiance_over_pi_shader");
+    j.key("irradiance_over_pi_shader" + suffix);
     json_triples(j, shader_, count);
     j.key("convention").value(sh_convention);
     j.key("window").begin_object();
@@ -166,9 +207,10 @@ std::string sh_stage::sh_json() const {
     j.key("kind").value("hanning");
     if (windowed_) j.key("width").value(width_);
     else j.key("width").null();
-    j.key("rule").value(auto_window_ ? "applied (weakest Hanning window keeping E >= 0 everywhere, ibl::sh_auto_window) only when "
-                                       "the unwindowed irradiance has a negative minimum"
-                                     : "never (scene plan: the raw projection; the shader clamps E at 0)");
+    j.key("choice").value(window_);
+    j.key("rule").value("'radiance' is the raw projection. --sh-window auto: the weakest Hanning window keeping E >= 0 "
+                        "(ibl::sh_auto_window) when the raw irradiance's minimum is below -5% of its mean in a channel; none; "
+                        "or a width W. A window scales band l of the irradiance and shader coefficients (then named *_windowed)");
     j.key("min_irradiance_before").begin_array().value(min_before_.x).value(min_before_.y).value(min_before_.z).end_array();
     j.key("min_irradiance_after").begin_array().value(min_after_.x).value(min_after_.y).value(min_after_.z).end_array();
     j.end_object();
@@ -182,6 +224,7 @@ void sh_stage::report(json_writer& j) const {
     j.key("method").value(std::to_string(bands_) + "-band projection of the source cube (exact texel solid angles), Lambert convolution");
     j.key("cost").begin_object().key("bands").value(bands_).key("texels").value(texels_).end_object();
     j.key("time_ms").value(ms_);
+    j.key("window_choice").value(window_);
     j.key("window_applied").value(windowed_);
     if (windowed_) j.key("window_width").value(width_);
     else j.key("window_width").null();
@@ -195,6 +238,7 @@ void sh_stage::report(json_writer& j) const {
     j.key("max_rel").value(c_.max_rel);
     j.key("mean_rel_unwindowed").value(c_.mean_rel_raw);
     j.key("max_rel_unwindowed").value(c_.max_rel_raw);
+    if (sun_) j.key("with_sun_vs_whole_source").begin_object().key("mean_rel").value(sun_mean_).key("max_rel").value(sun_max_).end_object();
     j.key("time_ms").value(c_.ms);
     j.end_object();
     j.end_object();
@@ -205,54 +249,68 @@ public:
     const char* key() const override { return "irradiance"; }
     stage_kind kind() const override { return stage_kind::product; }
     const char* category() const override { return "diffuse"; }
-    bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map; }
+    bool enabled(const bake_context& ctx) const override {
+        return ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map || (!ctx.scene_mode && ctx.opt.irradiance_size > 0);
+    }
     double product_ms() const override { return ms_; }
 
     void run(bake_context& ctx) override {
-        opt_.size = ctx.plan.diffuse.map_size;
-        opt_.samples = ctx.plan.diffuse.map_samples;
+        size_ = ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map ? ctx.plan.diffuse.map_size : ctx.opt.irradiance_size;
         ctx.prog.begin("irradiance map");
         ctx.diffuse.kind = ibl::diffuse_product::irradiance_map;
-        ctx.diffuse.map = ibl::irradiance_cubemap(ctx.source, opt_, ctx.ex);
+        ctx.diffuse.map = ibl::irradiance_cubemap_texel_moments(ctx.source, size_, max_face_, ctx.ex);
         ms_ = ctx.prog.end();
         map_ = &ctx.diffuse.map;
+        format_ = ctx.opt.ktx2_format;
         const auto t0 = std::chrono::steady_clock::now();
         c_.level = level_at_most(ctx.source, brute_max_face);
         c_.face = ctx.source.size(c_.level);
         const std::vector<dvec3> normals = check_normals();
         const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
-        accumulate(c_, normals, ref, [&](const dvec3& n) { return dvec3(map_->radiance(fvec3(n), 0.0f)); }, c_.mean_rel, c_.max_rel);
+        auto e = [&](const dvec3& n) { return dvec3(map_->radiance(fvec3(n), 0.0f)); };
+        accumulate(c_, normals, ref, e, c_.mean_rel, c_.max_rel);
+        sun_ = ctx.sun.has_value();
+        check_with_sun(ctx, normals, c_, e, sun_mean_, sun_max_);
         c_.ms = ms_since(t0);
     }
 
     std::vector<table_row> rows() const override {
-        return {{"irradiance map", "cosine importance sampling",
-                 std::to_string(opt_.size) + "^2, " + std::to_string(opt_.samples) + " spp", ms_,
-                 fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel)}};
+        std::string err = fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel);
+        if (sun_) err += fmt2("; + sun vs whole: mean rel %.3g, max rel %.3g", sun_mean_, sun_max_);
+        return {{"irradiance map", "texel moments over level 0", std::to_string(size_) + "^2, blocks <= " + std::to_string(max_face_) + "^2",
+                 ms_, err}};
     }
     std::vector<file_out> files() const override {
-        return {{"irradiance.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, ktx_cube(*map_), ktx2_format::rgba16f, "ibl-bake " + version_string());
-                 }}};
+        std::vector<file_out> f;
+        for (int face = 0; face < 6; ++face)
+            f.push_back({std::string("irradiance_") + face_names[face] + ".exr",
+                         [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0)); }});
+        f.push_back({"irradiance.ktx2", [this](const std::string& p) {
+                         write_ktx2_cubemap(p, ktx_cube(*map_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                     }});
+        return f;
     }
     void report(json_writer& j) const override {
         j.begin_object();
-        j.key("file").value("irradiance.ktx2");
-        j.key("method").value("irradiance cubemap by cosine importance sampling (ibl::irradiance_cubemap); texels hold E");
-        j.key("cost").begin_object().key("size").value(opt_.size).key("samples").value(opt_.samples).end_object();
+        j.key("files").value("irradiance_{px,nx,py,ny,pz,nz}.exr, irradiance.ktx2");
+        j.key("method").value("irradiance cubemap by texel moments over source level 0 (ibl::irradiance_cubemap_texel_moments); texels hold E");
+        j.key("cost").begin_object().key("size").value(size_).key("block_face").value(max_face_).end_object();
         j.key("time_ms").value(ms_);
         j.key("check").begin_object();
         j.key("reference").value("brute-force cosine integration over every texel of source level " + std::to_string(c_.level));
         j.key("normals").value(c_.normals).key("mean_rel").value(c_.mean_rel).key("max_rel").value(c_.max_rel);
+        if (sun_) j.key("with_sun_vs_whole_source").begin_object().key("mean_rel").value(sun_mean_).key("max_rel").value(sun_max_).end_object();
         j.key("time_ms").value(c_.ms);
         j.end_object();
         j.end_object();
     }
 
 private:
-    ibl::irradiance_options opt_;
+    int size_ = 32, max_face_ = 32;
+    std::string format_;
     const ibl::cubemap<float>* map_ = nullptr;
-    double ms_ = 0.0;
+    double ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
+    bool sun_ = false;
     irradiance_check c_;
 };
 

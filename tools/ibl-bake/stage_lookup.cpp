@@ -16,6 +16,8 @@
 #include <map>
 
 #include <ibl/integrate/lookup_error.hpp>
+#include <ibl/core/color.hpp>
+#include <ibl/integrate/metrics.hpp>
 #include <ibl/integrate/reference.hpp>
 
 namespace ibl_bake {
@@ -45,20 +47,25 @@ public:
         const std::vector<unsigned char> bytes =
             encode_ktx2_cubemap(ktx_cube(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
         const ibl::cubemap<float> stored = cube_from_ktx2_bytes(bytes, "specular.ktx2");
-        std::map<double, std::vector<dvec3>> cache; // the three sets share one reference per roughness
-        auto ref = [&](std::span<const dvec3> d, double r) {
-            auto it = cache.find(r);
-            if (it == cache.end()) it = cache.emplace(r, reference(ctx, d, r)).first;
-            return it->second;
-        };
-        sets_.push_back({ctx.opt.specular_lookup == "textbook" ? "textbook (chosen)" : "log-geometric (chosen)",
-                         ibl::specular_lookup_error(*ctx.chain, chosen, roughness_, dirs_, ref)});
-        sets_.push_back({"as stored in specular.ktx2 (" + ctx.opt.ktx2_format + ")",
-                         ibl::specular_lookup_error(stored, chosen, roughness_, dirs_, ref)});
         const bool textbook = ctx.opt.specular_lookup == "textbook";
-        sets_.push_back({textbook ? "log-geometric" : "textbook",
-                         ibl::specular_lookup_error(*ctx.chain, specular_lookup_named(textbook ? "default" : "textbook"),
-                                                    roughness_, dirs_, ref)});
+        const ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "default" : "textbook");
+        const std::string chosen_name = textbook ? "textbook (chosen)" : "log-geometric (chosen)";
+        const std::string stored_name = "as stored in specular.ktx2 (" + ctx.opt.ktx2_format + ")";
+        if (ctx.sun) { // the chain is the residual: measure what the runtime adds up (with the sun) against the whole
+            sets_.push_back(with_sun(ctx, *ctx.chain, chosen, chosen_name + " + sun"));
+            sets_.push_back(with_sun(ctx, stored, chosen, stored_name + " + sun"));
+            sets_.push_back(with_sun(ctx, *ctx.chain, other, std::string(textbook ? "log-geometric" : "textbook") + " + sun"));
+        } else {
+            std::map<double, std::vector<dvec3>> cache; // the three sets share one reference per roughness
+            auto ref = [&](std::span<const dvec3> d, double r) {
+                auto it = cache.find(r);
+                if (it == cache.end()) it = cache.emplace(r, reference(ctx, d, r)).first;
+                return it->second;
+            };
+            sets_.push_back({chosen_name, ibl::specular_lookup_error(*ctx.chain, chosen, roughness_, dirs_, ref)});
+            sets_.push_back({stored_name, ibl::specular_lookup_error(stored, chosen, roughness_, dirs_, ref)});
+            sets_.push_back({textbook ? "log-geometric" : "textbook", ibl::specular_lookup_error(*ctx.chain, other, roughness_, dirs_, ref)});
+        }
         ms_ = ms_since(t0);
         ctx.prog.end();
     }
@@ -84,6 +91,38 @@ private:
         return ibl::reference_ld_texel_sum(ctx.source, ibl::reference_ld_texel_level(ctx.source, r), d, r, ctx.ex);
     }
 
+    /// With an extracted sun: the runtime's LD (the chain's lookup plus the sun's exact LD term)
+    /// against the exact LD of the source before extraction (total error only: the residual's own
+    /// exact LD near the sun is a difference of two large numbers, no reference to measure against).
+    lookup_rows with_sun(const bake_context& ctx, const ibl::cubemap<float>& chain, const ibl::specular_lookup_desc& d,
+                         const std::string& name) {
+        product_view v = baked_view(ctx);
+        v.chain = &chain;
+        v.specular = d;
+        lookup_rows rows{name, {}};
+        for (const double r : roughness_) {
+            auto it = whole_.find(r);
+            if (it == whole_.end()) {
+                std::vector<dvec3> ref = ctx.src.analytic
+                                             ? reference(ctx, dirs_, r) // the sky's exact LD holds its sun
+                                             : ibl::reference_ld_texel_sum(ctx.whole_source(), ibl::reference_ld_texel_level(ctx.whole_source(), r),
+                                                                           std::span<const dvec3>(dirs_), r, ctx.ex);
+                it = whole_.emplace(r, std::move(ref)).first;
+            }
+            const std::vector<dvec3>& ref = it->second;
+            double mean = 0.0;
+            for (const auto& x : ref) mean += ibl::luminance(x) / double(ref.size());
+            ibl::error_accumulator acc(std::max(1e-3 * mean, 1e-30));
+            for (std::size_t i = 0; i < dirs_.size(); ++i)
+                acc.add(ibl::luminance(v.ld(dirs_[i], r) + sun_ld(v.sun, dirs_[i], r)), ibl::luminance(ref[i]));
+            ibl::specular_lookup_report rep;
+            rep.roughness = r;
+            rep.total = acc.finish();
+            rows.r.push_back(rep);
+        }
+        return rows;
+    }
+
     /// Worst total rel RMSE over r >= lo.
     static std::pair<double, double> worst(const std::vector<ibl::specular_lookup_report>& v, double lo) {
         double w = 0.0, at = 0.0;
@@ -95,6 +134,7 @@ private:
     std::vector<double> roughness_;
     std::vector<dvec3> dirs_;
     std::vector<lookup_rows> sets_;
+    std::map<double, std::vector<dvec3>> whole_;
     double ms_ = 0.0;
 };
 

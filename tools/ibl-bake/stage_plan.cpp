@@ -96,6 +96,9 @@ public:
         scene_name_ = ctx.scene.name;
         levels_ = ctx.set.levels;
         specular_lookup_ = ctx.opt.specular_lookup;
+        runtime_diffuse_ = ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map || (!ctx.scene_mode && ctx.opt.irradiance_size > 0)
+                               ? "irradiance_map"
+                               : diffuse_name(ctx.plan.diffuse.kind);
         dfg_layout_ = ctx.opt.dfg_layout;
     }
 
@@ -111,7 +114,7 @@ private:
     ibl::bake_plan plan_, full_;
     ibl::plan_cost est_, est_full_;
     std::vector<std::string> omitted_;
-    std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_;
+    std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_, runtime_diffuse_;
     int levels_ = 1;
 };
 
@@ -158,7 +161,7 @@ void plan_stage::report(json_writer& j) const {
     j.key("virtual_levels").value(plan_.specular.virtual_levels);
     j.key("first_level").value(plan_.specular.first_level);
     j.key("stored_levels").value(int(plan_.specular.levels.size()));
-    j.key("diffuse").value(diffuse_name(plan_.diffuse.kind));
+    j.key("diffuse").value(runtime_diffuse_); // the product the runtime shades with (sh.json may exist beside a map)
     j.key("sh_bands").value(plan_.diffuse.sh_bands);
     j.key("dfg_size").value(plan_.dfg.size);
     j.key("dfg_channels").value(plan_.dfg.channels);

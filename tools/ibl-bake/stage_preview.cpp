@@ -57,12 +57,12 @@ public:
         if (d2 < 1.0) { // orthographic sphere
             const dvec3 n = lx * cam_.right + ly * cam_.up - std::sqrt(1.0 - d2) * cam_.fwd;
             const dvec3 v = -cam_.fwd;
-            return shaders_[cj][ci].ambient(std::clamp(glm::dot(n, v), 0.0, 1.0), bp_.sample(n, v, 0.25 * ci));
+            return bp_.shade(shaders_[cj][ci], n, v);
         }
         const double tan_h = std::tan(0.5 * hfov_deg * ibl::pi_v<double> / 180.0), tan_v = tan_h * double(h) / double(w);
         const double ndc_x = 2.0 * fx / w - 1.0, ndc_y = 1.0 - 2.0 * fy / h;
         const dvec3 d = glm::normalize(cam_.fwd + ndc_x * tan_h * cam_.right + ndc_y * tan_v * cam_.up);
-        return dvec3(source_.radiance(fvec3(d), 0.0f));
+        return dvec3(source_.radiance(fvec3(d), 0.0f)); // the whole source (with its sun)
     }
 
     static constexpr int w = cols * cell, h = rows_ * cell;
@@ -84,7 +84,7 @@ public:
         ss_ = ctx.qs.preview_ss;
         ctx.prog.begin("preview");
         const product_view bp = baked_view(ctx);
-        const preview_renderer pr(bp, ctx.source, ctx.light);
+        const preview_renderer pr(bp, ctx.whole_source(), ctx.light);
         img_ = image_rgb32f(pr.w, pr.h);
         ctx.ex(std::size_t(pr.h), [&](std::size_t b, std::size_t e) {
             for (std::size_t py = b; py < e; ++py)

@@ -109,9 +109,18 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
         });
         return 0;
     });
-    // Relative errors use a floor of 1e-3 x the mean radiance (dark texels do not dominate).
+    // Relative errors use a floor of 1e-3 x the mean radiance (dark texels do not dominate). With an
+    // extracted sun the product is what the runtime gets: the level plus the sun's LD term (level 0:
+    // the texel with the removed excess added back, i.e. the source before extraction).
     ibl::error_accumulator acc(floor_);
-    for (std::size_t i = 0; i < texels.size(); ++i) acc.add(dvec3(chain_->texel(texels[i][0], texels[i][1], texels[i][2], k)), ref[i]);
+    const ibl::disk_light<double>* sun = ctx.sun ? &*ctx.sun : nullptr;
+    for (std::size_t i = 0; i < texels.size(); ++i) {
+        const auto& t = texels[i];
+        dvec3 got(chain_->texel(t[0], t[1], t[2], k));
+        if (sun && lp.level == 0 && ctx.whole_source().size(0) == lc.size) got = dvec3(ctx.whole_source().texel(t[0], t[1], t[2], 0));
+        else if (sun) got += sun_ld(sun, ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size), lc.roughness);
+        acc.add(got, ref[i]);
+    }
     lc.m = acc.finish();
     lc.texels = texels.size();
     lc.ref_ms = ms_since(t0);

@@ -1,6 +1,6 @@
 // tools/ibl-bake/stage_split_sum.cpp — check: what the baked products give through the runtime
-// model. The single-scattering ambient of shade.hpp from the baked chain (trilinear at
-// lod = policy(r)), the DFG table (bilinear) and the diffuse product, against
+// model. The single-scattering ambient of shade.hpp from the baked chain and DFG table (read by
+// ibl/lookup.hpp's lookups) and the diffuse product, plus an extracted sun as a disk light, against
 // ibl::reference_radiance (MIS of the BRDF and the source's luminance distribution, no split sum)
 // with the same diffuse weighting, for a dielectric and a metal at three roughness values, seen
 // in three views about the brightest direction.
@@ -68,8 +68,8 @@ public:
         samples_ = ctx.qs.split_sum_samples;
         ctx.prog.begin("check split sum");
         ibl::cube_env_distribution_options dopt;
-        dopt.level = level_at_most(ctx.source, dist_max_face);
-        const ibl::cube_env_distribution dist(ctx.source, dopt);
+        dopt.level = level_at_most(ctx.whole_source(), dist_max_face); // with its sun: the reference is of the whole
+        const ibl::cube_env_distribution dist(ctx.whole_source(), dopt);
         const std::vector<view_geom> views = make_views(ctx.light);
         nviews_ = views.size();
         const product_view bp = baked_view(ctx);
@@ -112,7 +112,7 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
     for (const view_geom& g : views) {
         const ibl::radiance_estimate ref = ctx.src.visit(
             [&](const auto& env) { return ibl::reference_radiance<bake_model>(env, dist, g.n, g.v, rm, ro, ctx.ex); });
-        const dvec3 split_lo = shader.ambient(g.n_dot_v, bp.sample(g.n, g.v, r));
+        const dvec3 split_lo = bp.shade(shader, g.n, g.v);
         const double yr = ibl::luminance(ref.value), ys = ibl::luminance(split_lo);
         const double rel = yr > 0.0 ? ys / yr - 1.0 : 0.0;
         res.views.push_back({g.name, g.n_dot_v, yr, ys, rel, yr > 0.0 ? ibl::luminance(ref.std_error) / yr : 0.0});

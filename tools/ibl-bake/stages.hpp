@@ -4,6 +4,7 @@
 //
 //   plan          the full plan, or the scene's plan (--scene) and what it leaves out
 //   source        read the input (or the built-in sky); k x k supersampled bake to the source cube
+//   sun           a compact dominant source taken out as a disk light (lights.json)
 //   specular      the plan's levels of the GGX-prefiltered chain (filtered importance sampling)
 //   sh            SH projection of the source cube (the plan's bands), window, irradiance
 //   irradiance    irradiance cubemap (when the plan chooses a map over SH)
@@ -30,6 +31,7 @@ namespace ibl_bake {
 
 std::unique_ptr<stage> make_plan_stage();
 std::unique_ptr<stage> make_source_stage();
+std::unique_ptr<stage> make_sun_stage();
 std::unique_ptr<stage> make_specular_stage();
 std::unique_ptr<stage> make_sh_stage();
 std::unique_ptr<stage> make_irradiance_stage();
@@ -64,10 +66,15 @@ struct product_view {
     const diffuse_data* diffuse = nullptr;
     ibl::specular_lookup_desc specular{};
     ibl::dfg_lut_layout dfg_layout{};
+    const ibl::disk_light<double>* sun = nullptr; ///< an extracted sun, added by the shading functions
 
-    /// LD at reflection direction r_dir and roughness.
+    /// LD at reflection direction r_dir and roughness (the chain only).
     dvec3 ld(const dvec3& r_dir, double roughness) const;
     ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
+    /// The runtime model: shader's ambient from the products plus the sun as a disk light.
+    dvec3 shade(const ibl::pbr_shader<double>& shader, const dvec3& n, const dvec3& v) const;
+    /// E(n) of the runtime (diffuse product plus the sun's cap irradiance), not E/pi.
+    dvec3 irradiance(const dvec3& n) const;
 };
 
 /// The DFG table layout and the specular lookup named by --dfg-layout / --specular-lookup.
@@ -81,6 +88,9 @@ product_view baked_view(const bake_context& ctx);
 
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
+
+/// The sun's LD at direction d and roughness r (its exact term, host quadrature); 0 without one.
+dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness);
 
 /// The first level of `cube` whose face is <= max_face (the last level if none is):
 /// ibl::irradiance_texel_sum_level.
@@ -120,6 +130,6 @@ void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level
 ibl::cubemap<float> cube_from_ktx2_bytes(const std::vector<unsigned char>& bytes, const std::string& name);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
-void json_triples(json_writer& j, const sh3& c, int count);
+void json_triples(json_writer& j, const sh5& c, int count);
 
 } // namespace ibl_bake

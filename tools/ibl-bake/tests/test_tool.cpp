@@ -231,7 +231,9 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     CHECK(is_triples(sh["irradiance"], 9));
     CHECK(sh["convention"].str.find("+Y up") != std::string::npos);
     CHECK(sh["window"]["applied"].kind == json::bool_v);
-    CHECK(sh["window"]["applied"].boolean); // the default sky's sun rings
+    CHECK_FALSE(sh["window"]["applied"].boolean); // the sun is extracted (lights.json): the residual does not ring
+    CHECK(slurp(out + "/lights.json").find("\"type\": \"sun\"") != std::string::npos);
+    for (const auto& f : faces) CHECK(read_image(out + "/irradiance_" + f + ".exr").width == 32);
     CHECK(sh["window"]["min_irradiance_before"].items.size() == 3);
 
     const json rep = parse_json(slurp(out + "/report.json"));
@@ -268,7 +270,7 @@ TEST_CASE("deterministic: bit-identical outputs with 1 and 2 threads") {
         CHECK(slurp(a + "/" + f) == slurp(b + "/" + f));
         ++compared;
     }
-    CHECK(compared == 18 + 5);
+    CHECK(compared == 18 + 5 + 8); // + irradiance_{face}.exr, irradiance.ktx2, lights.json
 }
 
 TEST_CASE("bad options: exit 2 with a message, nothing created") {
