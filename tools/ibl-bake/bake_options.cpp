@@ -94,6 +94,7 @@ const std::map<std::string, option_spec>& option_table() {
         {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
         {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
         {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
+        {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
         {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
@@ -223,6 +224,7 @@ std::string usage_text() {
            "  --sh-window W      auto (default) | none | Hanning width W: applied to irradiance and shader SH\n"
            "  --irradiance-size N  irradiance map face (default 32), 0 = none\n"
            "  --extract-sun S    auto (default) | on | off: a compact dominant source becomes lights.json\n"
+           "  --sheen            also the Charlie sheen chain and the sheen albedo LUT\n"
            "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
            "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"

@@ -25,6 +25,7 @@
 //   --sh-window W       auto (default) | none | a Hanning width > 0 (applies to irradiance / shader)
 //   --irradiance-size N irradiance map face 1..256 (default 32), 0 = no map (full bake)
 //   --extract-sun S     auto (default: extract a compact dominant source as a disk light) | on | off
+//   --sheen             also the sheen products (Charlie chain sheen_*.exr / sheen.ktx2, sheen_lut.exr)
 //   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
 //   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
@@ -69,7 +70,8 @@ struct bake_options {
     int sh_bands = 0;                          ///< --sh-bands 2..5; 0: the plan's (3 in the full bake)
     std::string sh_window = "auto";            ///< auto | none | a Hanning width W > 0
     int irradiance_size = 32;                  ///< --irradiance-size: face of the irradiance map (0: none)
-    std::string extract_sun = "auto";          ///< auto | on | off
+    std::string extract_sun = "auto";
+    bool sheen = false;                        ///< --sheen: the Charlie sheen chain and LUT          ///< auto | on | off
     std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
     std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)

@@ -134,7 +134,19 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         const auto shader = ibl::pbr_shader<double>::from(m, true);
         return triple(v.shade(shader, n, vv));
     }
-    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade)");
+    if (word == "sheen") {
+        need(4);
+        if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen chain (bake with --sheen)");
+        const dvec3 d = unit(a[0], a[1], a[2], "the direction");
+        const float lod = ibl::roughness_mip_policy::linear().lod(float(unit_interval(a[3])), b.sheen.levels());
+        return triple(dvec3(b.sheen.radiance(fvec3(d), lod)));
+    }
+    if (word == "dfg_sheen") {
+        need(2);
+        if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen table (bake with --sheen)");
+        return fmt9(b.sheen_lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1]))).x);
+    }
+    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen)");
 }
 
 } // namespace
@@ -179,6 +191,14 @@ baked_folder load_baked_folder(const std::string& dir) {
                                             member(l, "solid_angle", "lights.json").number,
                                             dvec3(rad.values.at(0).number, rad.values.at(1).number, rad.values.at(2).number)};
         }
+    }
+    if (const json_value* sh = rt.find("sheen"); sh && sh->boolean) {
+        b.sheen = cube_from_ktx2(dir + "/sheen.ktx2");
+        const image_rgb32f img = read_image(dir + "/sheen_lut.exr");
+        b.sheen_lut = ibl::dfg_lut{std::uint32_t(img.width), 1, {}};
+        for (int j = 0; j < img.height; ++j)
+            for (int i = 0; i < img.width; ++i) b.sheen_lut.data.push_back(img.texel(i, j)[0]);
+        b.has_sheen = true;
     }
     const std::string diffuse = member(rt, "diffuse", rp).string;
     if (diffuse == "sh") b.diffuse = sh_from_json(dir + "/sh.json");

@@ -12,6 +12,9 @@
 //                                 pbr_shader ambient, multiple scattering) for normal N, view V
 //                                 (towards the eye; both normalised), roughness R, metallic M,
 //                                 base colour B
+//   sheen X Y Z R               -> r g b   Charlie LD of the whole environment (a --sheen bake: the sheen
+//                                 chain, baked before sun extraction), textureLod at lod = r (V - 1)
+//   dfg_sheen NV R              -> E       the sheen albedo lookup (bilinear, texel centres)
 // With a sun in lights.json the answers are about the whole environment: specular adds the sun's
 // exact LD term (ibl::disk_light_ld), irradiance its cap irradiance, shade its disk-light shading.
 // R, NV, M are clamped to [0, 1] as the runtime does. A malformed query (unknown word, wrong count,
@@ -37,6 +40,9 @@ struct baked_folder {
     ibl::specular_lookup_desc specular{};
     ibl::dfg_lut_layout dfg_layout{};
     std::optional<ibl::disk_light<double>> sun; ///< lights.json's sun, if any
+    ibl::cubemap<float> sheen{1};               ///< the Charlie chain (--sheen bakes)
+    ibl::dfg_lut sheen_lut;
+    bool has_sheen = false;
 
     product_view view() const;
 };

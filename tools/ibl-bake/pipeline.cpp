@@ -25,6 +25,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     s.push_back(make_sh_stage());
     s.push_back(make_irradiance_stage());
     s.push_back(make_dfg_stage());
+    s.push_back(make_sheen_stage());
     s.push_back(make_lookup_stage());
     s.push_back(make_split_sum_stage());
     s.push_back(make_preview_stage());

@@ -96,6 +96,7 @@ public:
         scene_name_ = ctx.scene.name;
         levels_ = ctx.set.levels;
         specular_lookup_ = ctx.opt.specular_lookup;
+        sheen_ = ctx.opt.sheen;
         runtime_diffuse_ = ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map || (!ctx.scene_mode && ctx.opt.irradiance_size > 0)
                                ? "irradiance_map"
                                : diffuse_name(ctx.plan.diffuse.kind);
@@ -116,6 +117,7 @@ private:
     std::vector<std::string> omitted_;
     std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_, runtime_diffuse_;
     int levels_ = 1;
+    bool sheen_ = false;
 };
 
 std::vector<std::string> plan_stage::notes_before() const {
@@ -165,6 +167,7 @@ void plan_stage::report(json_writer& j) const {
     j.key("sh_bands").value(plan_.diffuse.sh_bands);
     j.key("dfg_size").value(plan_.dfg.size);
     j.key("dfg_channels").value(plan_.dfg.channels);
+    j.key("sheen").value(sheen_);
     json_lookup_conventions(j, specular_lookup_named(specular_lookup_), dfg_layout_named(dfg_layout_));
     j.end_object();
     j.key("products");

@@ -8,6 +8,7 @@
 //   specular      the plan's levels of the GGX-prefiltered chain (filtered importance sampling)
 //   sh            SH projection of the source cube (the plan's bands), window, irradiance
 //   irradiance    irradiance cubemap (when the plan chooses a map over SH)
+//   sheen         (--sheen) the Charlie sheen chain and the sheen albedo LUT
 //   dfg           the split-sum DFG table by exact quadrature
 //   lookup        check: the chain where a renderer samples it (between levels), vs exact LD
 //   split_sum     check: the baked products through the runtime model against the full integral
@@ -36,6 +37,7 @@ std::unique_ptr<stage> make_specular_stage();
 std::unique_ptr<stage> make_sh_stage();
 std::unique_ptr<stage> make_irradiance_stage();
 std::unique_ptr<stage> make_dfg_stage();
+std::unique_ptr<stage> make_sheen_stage();
 std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
 std::unique_ptr<stage> make_preview_stage();
