@@ -13,6 +13,8 @@
 #   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
 #   ibl/lookup.hpp    core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp (runtime lookups: no
 #                     integrator, no DFG table code; tables are read through their members)
+#   ibl/runtime.hpp   core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp shade.hpp lookup.hpp
+#                     (runtime approximations: reads the chain and tables, bakes nothing)
 #   ibl/batch.hpp     core/ brdf/ sampling/ env/ batch/ (kernels; never integrate/, which calls them)
 #   ibl/batch/**.hpp  the same, for every header under batch/ (also one the umbrella leaves out)
 #
@@ -30,6 +32,7 @@ set(rules
     "shade.hpp|core/ brdf/"
     "plan.hpp|core/ integrate/roughness_mip.hpp"
     "lookup.hpp|core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp"
+    "runtime.hpp|core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp shade.hpp lookup.hpp"
     "batch.hpp|core/ brdf/ sampling/ env/ batch/"
     "batch/*.hpp|core/ brdf/ sampling/ env/ batch/")
 

@@ -43,6 +43,13 @@
 // the worst per-level relative RMSE from 0.206 to 0.082 and the largest overshoot from 2.41 to
 // 1.40 for about 1.45 times the time of a constant 512. This is ibl-bake's default quality.
 //
+// LD weight (prefilter_options::weight). ld_weight::n_dot_l is Karis's n.l above. ld_weight::g1
+// weights each sample by the Smith masking of its direction instead,
+//     LD_G1(R) = integral L(l) D(h) G1(R.l) dl / integral D(h) G1(R.l) dl      (weight G1(n.l)),
+// which is the true specular lobe at normal view: with N = V = R the integrand f (n.l) is
+// D G2 / (4 n.v n.l) n.l = D G1(l) / 4 (height-correlated G2 with G1(v) = 1), so the split sum with
+// this LD is exact at n.v = 1 for every environment (docs/runtime.md measures both).
+//
 // Sample tables. Per output level one table of N Hammersley points (i / N, radical inverse),
 // shared by every texel: tangent-space l, weight n.l, lod; samples with n.l <= 0 are dropped.
 // Per texel the table is rotated into the frame make_frame(R) of the texel centre R. The hot loop
@@ -99,6 +106,12 @@ enum class prefilter_method : int {
     filtered_importance = 1, ///< Krivanek-Colbert filtered importance sampling
 };
 
+/// The per-sample weight of the LD integral (header: "LD weight").
+enum class ld_weight : int {
+    n_dot_l = 0, ///< Karis 2013: D(h) n.l
+    g1 = 1,      ///< D(h) G1(n.l): the specular lobe at n.v = 1
+};
+
 struct prefilter_options {
     /// Output levels, clamped to the full chain of base_size (floor(log2 base) + 1). Must be >= 0;
     /// 0 means the full chain.
@@ -119,6 +132,8 @@ struct prefilter_options {
     /// Cubemap fast path: trilinear reads (two bilinear taps per sample, the default); false reads
     /// only the nearest level round(lod) (one tap: half the cost, the lod quantised to whole levels).
     bool trilinear = true;
+    /// The LD weight (header: "LD weight"); the default is Karis's n.l.
+    ld_weight weight = ld_weight::n_dot_l;
 };
 
 /// Ceiling of the doubling sample schedule (samples per texel).
@@ -143,9 +158,12 @@ inline std::uint32_t default_prefilter_samples(prefilter_method method, int leve
 /// (N = V = R): N Hammersley draws h = L::sample, weights (n.l) L::ld_weight, lods from
 /// lod_of_solid_angle(Omega_s), Omega_s = 1 / (N pdf_l) (GGX: 4 / (N D(h))). Computed in double,
 /// stored as S. samples = 0 is clamped to 1; samples > limits::max_samples throws std::length_error.
+/// weight = ld_weight::g1 multiplies each sample's weight by the GGX G1(n.l) / n.l (the true
+/// D G1 weight instead of Karis' n.l; header: "LD weight"; meant for the GGX lobe).
 template <class S, class Lobe = ggx_lobe, class LodFn>
     requires ld_lobe<Lobe>
-sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, LodFn&& lod_of_solid_angle) {
+sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, LodFn&& lod_of_solid_angle,
+                                     ld_weight weight = ld_weight::n_dot_l) {
     detail::check_total("make_ld_table", "samples", samples, limits::max_samples, "limits::max_samples");
     const std::uint32_t n = samples > 0 ? samples : 1;
     sphere_sample_table<S> t;
@@ -154,7 +172,8 @@ sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, Lo
         const vec3<double> h = Lobe::sample(hammersley<double>(i, n), roughness);
         const double n_dot_l = 2.0 * h.z * h.z - 1.0;
         if (!(n_dot_l > 0.0)) continue;
-        const double w = n_dot_l * Lobe::ld_weight(h, roughness);
+        const double nl_or_g1 = weight == ld_weight::g1 ? g1_smith_ggx(n_dot_l, alpha_from_roughness(roughness)) : n_dot_l;
+        const double w = nl_or_g1 * Lobe::ld_weight(h, roughness);
         if (!(w > 0.0)) continue;
         const vec3<double> l(2.0 * h.z * h.x, 2.0 * h.z * h.y, n_dot_l);
         const double pdf_l = lobe_ld_pdf<Lobe>(h, roughness);
@@ -169,7 +188,8 @@ sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, Lo
 template <class S, class Lobe = ggx_lobe, class Env>
     requires ld_lobe<Lobe>
 sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::uint32_t samples,
-                                         prefilter_method method, double lod_bias) {
+                                         prefilter_method method, double lod_bias,
+                                         ld_weight weight = ld_weight::n_dot_l) {
     detail::check_total("make_ld_table_for", "samples", samples, limits::max_samples, "limits::max_samples");
     return make_ld_table<S, Lobe>(roughness, samples, [&](double omega_s) -> double {
         if (method == prefilter_method::importance) return 0.0;
@@ -177,7 +197,7 @@ sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::
         // The bias b scales the footprint by 4^b: 0.5 log2(4^b Omega_s / Omega_0) = lod + b.
         const double omega = omega_s * std::exp2(2.0 * lod_bias);
         return double(env_lod_for_solid_angle<Te>(env, Te(omega)));
-    });
+    }, weight);
 }
 
 namespace detail {
@@ -287,7 +307,7 @@ cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     for (int l = mirror_base ? 1 : 0; l < levels; ++l) {
         const double r = opt.policy.roughness(double(l), levels);
         sphere_sample_table<float> table =
-            make_ld_table_for<float, Lobe>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias);
+            make_ld_table_for<float, Lobe>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias, opt.weight);
         table.trilinear = opt.trilinear;
         store(l, convolve_faces(env, table, out.size(l), ex));
     }
