@@ -25,6 +25,7 @@ uniform int u_mode;
 uniform float u_roughness;
 uniform float u_tan_half_fov;
 uniform vec3 u_eye;
+uniform vec3 u_sphere_offset; // the spheres sit at -offset (dielectric) and +offset (metal)
 uniform vec3 u_light_dir;
 uniform vec3 u_light_irradiance; // 0: no direct light
 
@@ -78,7 +79,7 @@ vec3 preview_at(float fx, float fy) {
     return background(normalize(u_fwd + ndc_x * u_tan_half_fov * u_right + ndc_y * tan_v * u_up));
 }
 
-// The interactive view: a pinhole camera at u_eye, spheres of radius 1 at x = -1.15 and 1.15.
+// The interactive view: a pinhole camera at u_eye, spheres of radius 1 at -/+ u_sphere_offset.
 vec3 view_at(float fx, float fy) {
     float tan_v = u_tan_half_fov * u_size.y / u_size.x;
     float ndc_x = 2.0 * fx / u_size.x - 1.0, ndc_y = 1.0 - 2.0 * fy / u_size.y;
@@ -87,7 +88,7 @@ vec3 view_at(float fx, float fy) {
     vec3 hit_n = vec3(0.0);
     int hit = -1;
     for (int k = 0; k < 2; ++k) {
-        vec3 c = vec3(k == 0 ? -1.15 : 1.15, 0.0, 0.0);
+        vec3 c = k == 0 ? -u_sphere_offset : u_sphere_offset;
         vec3 oc = u_eye - c;
         float b = dot(oc, d), q = dot(oc, oc) - 1.0, disc = b * b - q;
         if (disc < 0.0) continue;

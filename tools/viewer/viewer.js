@@ -7,6 +7,7 @@
 //   test=preview render ibl-bake's preview.png exactly (640 x 256) and POST the pixels to `report`
 //   test=numeric evaluate the GLSL functions on fixed inputs (numeric.frag.glsl) and POST them
 //   report=URL   where a test POSTs its JSON result (tests/browser/run_browser_test.py serves it)
+//   roughness=, ev=, lookup=, scatter=, grid=1, light=1, ss=  the controls' initial values
 // Without bake=, pick the folder with the file picker (the browser reads it locally).
 //
 // Files read from the folder: specular.ktx2 (required), dfg.hpp (required: the exact float table
@@ -250,7 +251,7 @@ class Renderer {
         gl.uniform1f(u('u_exposure'), this.exposure * Math.pow(2, view.ev || 0));
         gl.uniform1i(u('u_mode'), view.mode);
         gl.uniform1f(u('u_roughness'), view.roughness ?? 0.25);
-        let cam, eye = [0, 0, 0], tanHalf;
+        let cam, eye = [0, 0, 0], offset = [1.15, 0, 0], tanHalf;
         if (view.mode === 0) {
             cam = previewCamera(this.light);
             tanHalf = Math.tan(0.5 * 90 * Math.PI / 180);
@@ -263,7 +264,8 @@ class Renderer {
             const right = [Math.cos(yaw), 0, Math.sin(yaw)];
             const up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2], right[0] * fwd[1] - right[1] * fwd[0]];
             cam = { fwd, right, up };
-            eye = fwd.map((x) => -4.2 * x);
+            eye = fwd.map((x) => -5.5 * x);
+            offset = base.right.map((x) => 1.15 * x);
             tanHalf = Math.tan(0.5 * 60 * Math.PI / 180);
             gl.uniform1i(u('u_ss'), view.ss || 1);
         }
@@ -271,6 +273,7 @@ class Renderer {
         gl.uniform3fv(u('u_right'), cam.right);
         gl.uniform3fv(u('u_up'), cam.up);
         gl.uniform3fv(u('u_eye'), eye);
+        gl.uniform3fv(u('u_sphere_offset'), offset);
         gl.uniform1f(u('u_tan_half_fov'), tanHalf);
         gl.uniform3fv(u('u_light_dir'), this.light);
         // The optional light: irradiance pi x the mean radiance (a light as bright as the whole sky).
@@ -379,11 +382,17 @@ async function runViewer() {
             canvas.height = grid ? 256 : Math.floor(canvas.clientHeight * dpr);
             canvas.style.width = grid ? '640px' : '100vw';
             canvas.style.height = grid ? '256px' : '100vh';
+            canvas.style.margin = grid ? '8px 0 0 400px' : '0'; // beside the panel
             renderer.draw(view);
         });
     };
     const bind = (id, key, parse, show) => {
         const input = el(id);
+        const initial = params.get(id); // ?roughness=0.5&ev=1&lookup=textbook&grid=1 ...
+        if (initial !== null) {
+            if (input.type === 'checkbox') input.checked = initial === '1';
+            else input.value = initial;
+        }
         const update = () => { view[key] = parse(input); if (show) el(id + '_v').textContent = show(view[key]); redraw(); };
         input.addEventListener('input', update);
         update();
