@@ -1,0 +1,35 @@
+// tests/browser/glsl_check_main.glsl — a fragment shader body that calls every function of
+// include/ibl/glsl/*.glsl; check_glsl.py compiles it after the include files as GLSL ES 3.00 and
+// as GLSL 4.50 (glslangValidator).
+
+uniform samplerCube u_chain;
+uniform samplerCube u_irradiance;
+uniform sampler2D u_lut;
+uniform vec3 u_sh[9];
+uniform vec3 u_n, u_v, u_l;
+uniform float u_r;
+#ifdef GL_ES
+out vec4 o_color;
+#else
+layout(location = 0) out vec4 o_color;
+#endif
+
+void main() {
+    ibl_specular_desc sd = ibl_specular_default(6, 0, 6);
+    ibl_specular_desc tb = ibl_specular_textbook(6, 0, 6);
+    ibl_specular_desc cr = ibl_specular_desc(6, 1, 5, IBL_MAPPING_FILAMENT, IBL_WEIGHT_POWER, 2.0, IBL_INTERP_CATMULL_ROM);
+    ibl_specular_taps t = ibl_specular_lookup_taps(u_r, 6, cr);
+    vec3 b = ibl_specular_blend(t, u_n, u_v, u_l, u_n, cr);
+    vec3 ld = ibl_specular_lookup(u_chain, u_n, u_r, sd) + ibl_specular_lookup(u_chain, u_n, u_r, tb);
+    ibl_dfg_layout lay = ibl_dfg_layout_default();
+    vec3 abk = ibl_dfg_lookup(u_lut, dot(u_n, u_v), u_r, lay) + ibl_dfg_lookup(u_lut, 0.5, u_r, ibl_dfg_layout_uniform());
+    vec3 e = ibl_sh_irradiance_over_pi(u_sh, u_n) + ibl_irradiance_map_over_pi(u_irradiance, u_n);
+    ibl_material_terms m = ibl_resolve_material(ibl_make_material(vec3(0.8), 0.0, u_r));
+    ibl_sample s = ibl_lookup_sample(u_chain, sd, u_lut, lay, u_n, u_v, u_r, e);
+    vec3 a = ibl_ambient(m, dot(u_n, u_v), s, true) + ibl_ambient(m, dot(u_n, u_v), s, false);
+    ibl_multiscatter_terms ms = ibl_multiscatter(m.f0, m.f90, abk.xy);
+    vec3 sp = ibl_specular_ibl_multiscatter(ms, ld, e);
+    vec3 d = ibl_shade_directional(u_n, u_v, u_l, vec3(1.0), m) + ibl_shade_point(vec3(0.0), u_n, u_v, u_l, vec3(1.0), m);
+    vec3 br = ibl_specular_brdf_direct(0.5, ibl_make_light_cosines(u_n, u_v, u_l), m.f0, m.f90, u_r);
+    o_color = vec4(b + ld + a + sp + d + br + t.lod, 1.0);
+}

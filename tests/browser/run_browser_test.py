@@ -1,0 +1,362 @@
+#!/usr/bin/python3
+"""tests/browser/run_browser_test.py: the library's GLSL in a real browser (headless Chromium on
+SwiftShader's WebGL2), compared with the C++.
+
+  preview  bakes a small folder with the built ibl-bake (--size 32 --quality low), serves the
+           repository's tools/viewer/ and include/ibl/glsl/ and the folder on 127.0.0.1, lets
+           tools/viewer/index.html?test=preview render ibl-bake's preview grid from specular.ktx2,
+           dfg.hpp, sh.json and report.json, and compares its pixels with the bake's own
+           preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
+  screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
+           interactive viewer to --out (docs/shaders-viewer.png).
+  numeric  lets tools/viewer/numeric.frag.glsl evaluate the GLSL functions on a fixed grid of
+           inputs and compares them with the same grid evaluated by the library in C++
+           (glsl_reference, tests/browser/glsl_reference.cpp).
+
+Everything this script starts (the bake, Chromium, the HTTP server thread) ends before it returns.
+Exit status 0 = pass. docs/shaders.md explains the bounds.
+"""
+
+import argparse
+import base64
+import http.server
+import json
+import math
+import os
+import shutil
+import signal
+import struct
+import subprocess
+import sys
+import tempfile
+import threading
+import zlib
+
+
+# ---- PNG (8-bit RGB / RGBA, non-interlaced: what stb_image_write produces) ----------------------
+
+def read_png_rgb(path):
+    data = open(path, "rb").read()
+    if data[:8] != b"\x89PNG\r\n\x1a\n":
+        raise ValueError(f"{path}: not a PNG")
+    pos, idat, w = 8, b"", None
+    while pos < len(data):
+        (n,) = struct.unpack(">I", data[pos:pos + 4])
+        kind, body = data[pos + 4:pos + 8], data[pos + 8:pos + 8 + n]
+        pos += 12 + n
+        if kind == b"IHDR":
+            w, h, depth, ctype, _, _, interlace = struct.unpack(">IIBBBBB", body)
+            if depth != 8 or ctype not in (2, 6) or interlace:
+                raise ValueError(f"{path}: only 8-bit RGB/RGBA non-interlaced PNGs are read")
+            bpp = 3 if ctype == 2 else 4
+        elif kind == b"IDAT":
+            idat += body
+        elif kind == b"IEND":
+            break
+    raw = zlib.decompress(idat)
+    stride = w * bpp
+    out = bytearray(h * stride)
+    prev = bytearray(stride)
+    for y in range(h):
+        f = raw[y * (stride + 1)]
+        line = bytearray(raw[y * (stride + 1) + 1:(y + 1) * (stride + 1)])
+        for i in range(stride):
+            a = line[i - bpp] if i >= bpp else 0
+            b = prev[i]
+            c = prev[i - bpp] if i >= bpp else 0
+            if f == 1:
+                line[i] = (line[i] + a) & 255
+            elif f == 2:
+                line[i] = (line[i] + b) & 255
+            elif f == 3:
+                line[i] = (line[i] + (a + b) // 2) & 255
+            elif f == 4:
+                p = a + b - c
+                pa, pb, pc = abs(p - a), abs(p - b), abs(p - c)
+                pr = a if pa <= pb and pa <= pc else (b if pb <= pc else c)
+                line[i] = (line[i] + pr) & 255
+        out[y * stride:(y + 1) * stride] = line
+        prev = line
+    if bpp == 4:
+        out = bytearray(v for i, v in enumerate(out) if i % 4 != 3)
+    return w, h, bytes(out)
+
+
+# ---- the page's server ------------------------------------------------------------------------------
+
+class Server:
+    """Serves /tools/viewer/, /include/ibl/glsl/ from the repository and /bake/ from the bake folder;
+    a POST to /result stores the page's JSON."""
+
+    def __init__(self, repo, bake_dir):
+        self.result = None
+        self.done = threading.Event()
+        outer = self
+        roots = {"/tools/viewer/": os.path.join(repo, "tools", "viewer"),
+                 "/include/ibl/glsl/": os.path.join(repo, "include", "ibl", "glsl"),
+                 "/bake/": bake_dir}
+
+        class Handler(http.server.BaseHTTPRequestHandler):
+            def log_message(self, *args):
+                pass
+
+            def _file(self):
+                path = self.path.split("?")[0]
+                for prefix, root in roots.items():
+                    if path.startswith(prefix):
+                        name = path[len(prefix):] or "index.html"
+                        if "/" in name or name.startswith("."):
+                            return None
+                        full = os.path.join(root, name)
+                        return full if os.path.isfile(full) else None
+                return None
+
+            def _send(self, head_only):
+                full = self._file()
+                if not full:
+                    self.send_error(404)
+                    return
+                body = open(full, "rb").read()
+                ctype = {".html": "text/html", ".js": "text/javascript", ".json": "application/json"}.get(
+                    os.path.splitext(full)[1], "application/octet-stream")
+                self.send_response(200)
+                self.send_header("Content-Type", ctype)
+                self.send_header("Content-Length", str(len(body)))
+                self.send_header("Cache-Control", "no-store")
+                self.end_headers()
+                if not head_only:
+                    self.wfile.write(body)
+
+            def do_GET(self):
+                self._send(False)
+
+            def do_HEAD(self):
+                self._send(True)
+
+            def do_POST(self):
+                n = int(self.headers.get("Content-Length", "0"))
+                body = self.rfile.read(n)
+                self.send_response(204)
+                self.end_headers()
+                if self.path.startswith("/result") and outer.result is None:
+                    outer.result = json.loads(body)
+                    outer.done.set()
+
+        self.httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), Handler)
+        self.port = self.httpd.server_address[1]
+        self.thread = threading.Thread(target=self.httpd.serve_forever, daemon=True)
+        self.thread.start()
+
+    def close(self):
+        self.httpd.shutdown()
+        self.httpd.server_close()
+        self.thread.join()
+
+
+def run_page(chromium, url, profile, timeout, server):
+    cmd = [chromium, "--headless=new", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox",
+           "--disable-gpu-sandbox", "--no-first-run", "--disable-background-networking", "--disable-component-update",
+           "--disable-sync", "--disable-extensions", "--mute-audio", f"--user-data-dir={profile}",
+           "--window-size=800,400", url]
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, start_new_session=True)
+    try:
+        if not server.done.wait(timeout):
+            raise RuntimeError(f"no result from the page within {timeout} s")
+    finally:
+        try:
+            os.killpg(proc.pid, signal.SIGTERM)  # the browser's own process group (started above)
+        except ProcessLookupError:
+            pass
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait()
+        if proc.stderr:
+            proc.stderr.close()
+    if server.result.get("kind") == "error":
+        raise RuntimeError("page error: " + server.result["error"])
+    return server.result
+
+
+# ---- preview comparison ------------------------------------------------------------------------------
+
+CELL, COLS, ROWS = 128, 5, 2
+
+
+def coverage_ambiguous(px, py, ss, margin):
+    """True if a sub-pixel sample of pixel (px, py) lies within `margin` of a sphere's rim
+    (|d2 - 1| < margin): float and double may classify it differently (sphere vs background)."""
+    radius = 0.45 * CELL
+    for sy in range(ss):
+        for sx in range(ss):
+            fx, fy = px + (sx + 0.5) / ss, py + (sy + 0.5) / ss
+            ci, cj = min(int(fx) // CELL, COLS - 1), min(int(fy) // CELL, ROWS - 1)
+            lx, ly = (fx - (ci + 0.5) * CELL) / radius, -(fy - (cj + 0.5) * CELL) / radius
+            if abs(lx * lx + ly * ly - 1.0) < margin:
+                return True
+    return False
+
+
+def max_slope_8bit():
+    """max over x > 0 of d(255 sRGB(Reinhard(x))) / d ln x: the 8-bit change per unit relative
+    change of the linear radiance (the derivation of the tolerance)."""
+    best = 0.0
+    for k in range(-4000, 4000):
+        x = math.exp(k / 400.0)
+        r = x / (1 + x)
+        dr = r * (1 - r)  # dr / d ln x
+        ds = 12.92 if r <= 0.0031308 else 1.055 / 2.4 * r ** (1 / 2.4 - 1)
+        best = max(best, 255.0 * ds * dr)
+    return best
+
+
+def compare_preview(bake_dir, result):
+    w, h, ref = read_png_rgb(os.path.join(bake_dir, "preview.png"))
+    got = base64.b64decode(result["rgb"])
+    if (w, h) != (result["width"], result["height"]) or len(got) != len(ref):
+        raise RuntimeError(f"size mismatch: preview.png {w}x{h}, page {result['width']}x{result['height']}")
+    info = result["info"]
+    ss = info["preview_ss"]
+    if "SwiftShader" not in info["renderer"]:
+        raise RuntimeError(f"renderer {info['renderer']!r}: the bound below is derived for SwiftShader (float filtering)")
+    # Relative error of the linear radiance between the two renderers (docs/shaders.md):
+    #   chain: the default RGBA16F holds every texel within 2^-11 relative (round to nearest);
+    #   LD is a convex (bilinear, linear blend, textbook) or geometric (L_l^(1-t) L_{l+1}^t)
+    #   combination of texels, both of which keep a relative bound. RGBA32F is exact;
+    #   B10G11R11 is within 2^-7 (R, G) and 2^-6 (B). E5B9G9R9's error is relative to the
+    #   texel's largest channel: no per-channel relative bound, so no test bound.
+    #   DFG table: dfg.hpp's exact floats in an RGBA32F texture: no storage error.
+    #   Arithmetic: float (GPU) vs double (the C++ shading, float lookups): < 1e-5 relative.
+    #   Filtering: SwiftShader computes bilinear weights in float. A GPU that quantises them
+    #   (Vulkan guarantees only subTexelPrecisionBits >= 4) errs by a fraction of the difference
+    #   of neighbouring texels, which no relative bound covers: the bound holds for SwiftShader.
+    chain_eps = {"R16G16B16A16_SFLOAT": 2.0 ** -11, "R32G32B32A32_SFLOAT": 0.0, "B10G11R11_UFLOAT_PACK32": 2.0 ** -6}
+    if info["chain_format"] not in chain_eps:
+        raise RuntimeError(f"no bound derived for a {info['chain_format']} chain")
+    if info["lut_texture"] != "RGBA32F":
+        raise RuntimeError("the DFG table is not an RGBA32F texture (no OES_texture_float_linear): no bound derived")
+    eps = chain_eps[info["chain_format"]] + 1e-5
+    slope = max_slope_8bit()
+    # Both sides round the same function to 8 bits: if the unrounded values differ by less than
+    # delta = slope * eps (in 8-bit units), the rounded ones differ by at most floor(delta) + 1.
+    delta = slope * eps
+    bound = math.floor(delta) + 1
+    diffs, amb, hist = [], 0, {}
+    worst = (0, 0, 0)
+    for y in range(h):
+        for x in range(w):
+            if coverage_ambiguous(x, y, ss, 1e-5):
+                amb += 1
+                continue
+            i = 3 * (y * w + x)
+            d = max(abs(got[i + c] - ref[i + c]) for c in range(3))
+            diffs.append(sum(abs(got[i + c] - ref[i + c]) for c in range(3)) / 3.0)
+            hist[d] = hist.get(d, 0) + 1
+            if d > worst[0]:
+                worst = (d, x, y)
+    total = sum(diffs) / len(diffs)
+    print(f"renderer: {info['renderer']}")
+    print(f"chain {info['chain_format']} levels {info['chain_levels']}, DFG texture {info['lut_texture']} "
+          f"{info['lut_size']}^2, exposure {info['exposure']:.8g}, {ss}x{ss} samples per pixel")
+    print(f"derived: eps = {eps:.3g} relative, max 8-bit slope {slope:.2f} per unit ln L, delta {delta:.3f} "
+          f"-> bound {bound} (8-bit units)")
+    print(f"pixels compared {len(diffs)} (excluded {amb} whose samples lie within 1e-5 of a sphere rim)")
+    print(f"max |diff| {worst[0]} at ({worst[1]}, {worst[2]}), mean |diff| {total:.4f} (8-bit units, per channel)")
+    print("histogram of max channel |diff|: " + ", ".join(f"{k}: {hist[k]}" for k in sorted(hist)))
+    ok = worst[0] <= bound
+    print("PASS" if ok else f"FAIL: max |diff| {worst[0]} > bound {bound}")
+    return ok
+
+
+# ---- numeric comparison ------------------------------------------------------------------------------
+
+def compare_numeric(reference_exe, result):
+    ref = json.loads(subprocess.run([reference_exe], check=True, capture_output=True, text=True).stdout)
+    w, h = result["width"], result["height"]
+    vals = result["values"]  # rows from the bottom (readPixels), RGBA
+    if (w, h) != (ref["width"], ref["height"]):
+        raise RuntimeError("grid size mismatch")
+    ok, worst = True, {}
+    for row in ref["rows"]:
+        j, name, tol_rel, tol_abs = row["row"], row["name"], row["rel"], row["abs"]
+        wmax = 0.0
+        for i, expect in enumerate(row["values"]):
+            got = vals[4 * (j * w + i):4 * (j * w + i) + 4]
+            for c in range(4):
+                e, g = expect[c], got[c]
+                err = abs(g - e)
+                lim = tol_abs + tol_rel * abs(e)
+                wmax = max(wmax, err / lim if lim > 0 else err)
+                if not err <= lim:
+                    if ok or worst.get(name, 0) < 3:
+                        print(f"  {name}[{i}].{c}: GLSL {g!r} C++ {e!r} |diff| {err:.3g} > {lim:.3g}")
+                    worst[name] = worst.get(name, 0) + 1
+                    ok = False
+        print(f"{name:28s} {len(row['values'])} cases x 4: worst |diff| / bound {wmax:.3g} "
+              f"(bound {tol_abs:g} + {tol_rel:g} |C++|)")
+    print(f"renderer: {result.get('renderer')}")
+    print("PASS" if ok else "FAIL")
+    return ok
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--mode", choices=["preview", "numeric", "screenshot"], required=True)
+    ap.add_argument("--tool", help="ibl-bake (preview)")
+    ap.add_argument("--reference", help="glsl_reference (numeric)")
+    ap.add_argument("--chromium", default="chromium")
+    ap.add_argument("--repo", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
+    ap.add_argument("--size", default="32", help="face size of the preview test's bake")
+    ap.add_argument("--quality", default="low", help="quality of the preview test's bake")
+    ap.add_argument("--input", help="the preview test's --input (default: the built-in sky)")
+    ap.add_argument("--bake-args", default="", help="more ibl-bake options for the preview test, space separated")
+    ap.add_argument("--keep", help="copy the bake folder and the page's pixels here")
+    ap.add_argument("--timeout", type=float, default=120.0)
+    ap.add_argument("--out", help="screenshot: the PNG to write")
+    ap.add_argument("--query", default="", help="screenshot: more query parameters, e.g. '&roughness=0.3'")
+    ap.add_argument("--window", default="1000,470", help="screenshot: window size W,H")
+    a = ap.parse_args()
+    work = tempfile.mkdtemp(prefix="ibl-browser-")
+    try:
+        bake_dir = os.path.join(work, "bake")
+        os.makedirs(bake_dir)
+        if a.mode in ("preview", "screenshot"):
+            subprocess.run([a.tool, "--size", a.size, "--quality", a.quality, "--out", bake_dir, "--quiet"] +
+                           (["--input", a.input] if a.input else []) + a.bake_args.split(), check=True,
+                           stdout=subprocess.DEVNULL)
+        server = Server(os.path.abspath(a.repo), bake_dir)
+        if a.mode == "screenshot":
+            try:
+                url = f"http://127.0.0.1:{server.port}/tools/viewer/index.html?bake=/bake/&glsl=/include/ibl/glsl/{a.query}"
+                # --virtual-time-budget lets the page's fetches and first frame finish before the shot.
+                subprocess.run([a.chromium, "--headless=new", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                                "--no-sandbox", "--disable-gpu-sandbox", "--no-first-run",
+                                "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                                f"--user-data-dir={os.path.join(work, 'profile')}", f"--window-size={a.window}",
+                                "--virtual-time-budget=20000", "--hide-scrollbars", f"--screenshot={os.path.abspath(a.out)}",
+                                url], check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, timeout=a.timeout)
+            finally:
+                server.close()
+            return 0
+        try:
+            url = (f"http://127.0.0.1:{server.port}/tools/viewer/index.html?test={a.mode}&bake=/bake/"
+                   f"&glsl=/include/ibl/glsl/&report=/result")
+            result = run_page(a.chromium, url, os.path.join(work, "profile"), a.timeout, server)
+        finally:
+            server.close()
+        if a.mode == "preview":
+            ok = compare_preview(bake_dir, result)
+            if a.keep:
+                os.makedirs(a.keep, exist_ok=True)
+                shutil.copytree(bake_dir, os.path.join(a.keep, "bake"), dirs_exist_ok=True)
+                open(os.path.join(a.keep, "browser_rgb.bin"), "wb").write(base64.b64decode(result["rgb"]))
+        else:
+            ok = compare_numeric(a.reference, result)
+        return 0 if ok else 1
+    finally:
+        shutil.rmtree(work, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,449 @@
+// tools/viewer/viewer.js — WebGL2 viewer of an ibl-bake output folder, shaded by the library's
+// GLSL (include/ibl/glsl/*.glsl). docs/shaders.md describes it.
+//
+// Query parameters:
+//   bake=URL     the bake folder (relative to this page or absolute), e.g. ?bake=../../build/bake/
+//   glsl=URL     where ibl_*.glsl live (default ../../include/ibl/glsl/)
+//   test=preview render ibl-bake's preview.png exactly (640 x 256) and POST the pixels to `report`
+//   test=numeric evaluate the GLSL functions on fixed inputs (numeric.frag.glsl) and POST them
+//   report=URL   where a test POSTs its JSON result (tests/browser/run_browser_test.py serves it)
+//   roughness=, ev=, lookup=, scatter=, grid=1, light=1, ss=  the controls' initial values
+// Without bake=, pick the folder with the file picker (the browser reads it locally).
+//
+// Files read from the folder: specular.ktx2 (required), dfg.hpp (required: the exact float table
+// in the layout of report.json), report.json (plan.runtime: the lookup conventions; source: the
+// exposure and camera of the preview), sh.json ("irradiance_over_pi_shader") or irradiance.ktx2.
+
+import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
+
+const params = new URLSearchParams(location.search);
+const testMode = params.get('test');
+const glslBase = params.get('glsl') || '../../include/ibl/glsl/';
+const statusEl = document.getElementById('status');
+const log = (s) => { if (statusEl) statusEl.textContent += s + '\n'; };
+
+// ---- where the bake's files come from --------------------------------------------------------------
+
+function urlSource(base) {
+    if (!base.endsWith('/')) base += '/';
+    const get = async (name) => {
+        const r = await fetch(base + name);
+        if (!r.ok) throw new Error(`${base + name}: HTTP ${r.status}`);
+        return r;
+    };
+    return {
+        label: base,
+        has: async (name) => { try { return (await fetch(base + name, { method: 'HEAD' })).ok; } catch { return false; } },
+        text: async (name) => (await get(name)).text(),
+        bytes: async (name) => (await get(name)).arrayBuffer(),
+    };
+}
+
+function fileSource(files) {
+    const byName = new Map();
+    for (const f of files) byName.set(f.name, f);
+    const get = (name) => {
+        const f = byName.get(name);
+        if (!f) throw new Error(`${name} is not in the chosen folder`);
+        return f;
+    };
+    return {
+        label: files.length ? (files[0].webkitRelativePath || files[0].name).split('/')[0] : '(none)',
+        has: async (name) => byName.has(name),
+        text: async (name) => get(name).text(),
+        bytes: async (name) => get(name).arrayBuffer(),
+    };
+}
+
+/// The table of dfg.hpp (ibl::dfg_lut_header): size, channels, values row by row.
+export function parseDfgHeader(text) {
+    const size = +(/dfg_lut_size\s*=\s*(\d+)/.exec(text) || [])[1];
+    const channels = +(/dfg_lut_channels\s*=\s*(\d+)/.exec(text) || [])[1];
+    const start = text.indexOf('{', text.search(/dfg_lut\s*\[\s*\d+\s*\]\s*=/));
+    const end = text.indexOf('}', start);
+    if (!(size > 0) || !(channels > 0) || start < 0 || end < 0) throw new Error('dfg.hpp: no dfg_lut table');
+    const values = text.slice(start + 1, end).split(',').map((s) => s.trim()).filter((s) => s.length).map(parseFloat);
+    if (values.length !== size * size * channels || values.some((v) => !Number.isFinite(v)))
+        throw new Error(`dfg.hpp: ${values.length} values, expected ${size * size * channels}`);
+    return { size, channels, values: Float32Array.from(values) };
+}
+
+async function loadBake(src) {
+    const bake = { label: src.label };
+    bake.report = (await src.has('report.json')) ? JSON.parse(await src.text('report.json')) : null;
+    bake.sh = (await src.has('sh.json')) ? JSON.parse(await src.text('sh.json')) : null;
+    bake.dfg = parseDfgHeader(await src.text('dfg.hpp'));
+    bake.chain = parseKtx2Cubemap(await src.bytes('specular.ktx2'), 'specular.ktx2');
+    bake.irradiance = (await src.has('irradiance.ktx2')) ? parseKtx2Cubemap(await src.bytes('irradiance.ktx2'), 'irradiance.ktx2') : null;
+    return bake;
+}
+
+// ---- conventions from report.json ------------------------------------------------------------------
+
+const AXIS = { linear: 0, sqrt: 1, cbrt: 2 };
+const WEIGHT = { lod: 0, power: 1, log: 2 };
+const INTERP = { linear: 0, catmull_rom: 1, geometric: 2 };
+
+function runtimeOf(bake) {
+    const rt = (bake.report && bake.report.plan && bake.report.plan.runtime) || {};
+    const stored = bake.chain.levels.length;
+    const spec = rt.specular_lookup || { weight: 'log', interpolation: 'geometric', name: 'log-geometric' };
+    const lay = rt.dfg_layout || { n_dot_v: 'cbrt', roughness: 'sqrt', edge_aligned: true };
+    const diffuse = rt.diffuse || (bake.sh ? 'sh' : bake.irradiance ? 'irradiance_map' : 'none');
+    return {
+        virtualLevels: rt.virtual_levels ?? stored,
+        firstLevel: rt.first_level ?? 0,
+        stored,
+        mapping: rt.policy === 'filament' ? 1 : 0,
+        spec,
+        layout: [AXIS[lay.n_dot_v] ?? 2, AXIS[lay.roughness] ?? 1, lay.edge_aligned === false ? 0 : 1],
+        diffuse,
+    };
+}
+
+/// The preview's camera (stage_preview.cpp make_camera): looking horizontally away from `light`.
+export function previewCamera(light) {
+    let f = [-light[0], 0, -light[2]];
+    const l2 = f[0] * f[0] + f[2] * f[2];
+    f = l2 > 1e-12 ? [f[0] / Math.sqrt(l2), 0, f[2] / Math.sqrt(l2)] : [0, 0, -1];
+    const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+    const norm = (a) => { const n = Math.hypot(a[0], a[1], a[2]); return [a[0] / n, a[1] / n, a[2] / n]; };
+    const right = norm(cross(f, [0, 1, 0]));
+    return { fwd: f, right, up: cross(right, f) };
+}
+
+// ---- GL ------------------------------------------------------------------------------------------
+
+const VERTEX = `#version 300 es
+void main() {
+    vec2 p = vec2(float((gl_VertexID << 1) & 2), float(gl_VertexID & 2));
+    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);
+}`;
+const HEADER = '#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp samplerCube;\nprecision highp sampler2D;\n';
+
+async function fetchText(url) {
+    const r = await fetch(url);
+    if (!r.ok) throw new Error(`${url}: HTTP ${r.status}`);
+    return r.text();
+}
+
+async function libraryGlsl() {
+    const parts = [];
+    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl']) parts.push(await fetchText(glslBase + f));
+    return parts.join('\n');
+}
+
+function compile(gl, vsrc, fsrc) {
+    const sh = (type, src) => {
+        const s = gl.createShader(type);
+        gl.shaderSource(s, src);
+        gl.compileShader(s);
+        if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error('shader: ' + gl.getShaderInfoLog(s));
+        return s;
+    };
+    const p = gl.createProgram();
+    gl.attachShader(p, sh(gl.VERTEX_SHADER, vsrc));
+    gl.attachShader(p, sh(gl.FRAGMENT_SHADER, fsrc));
+    gl.linkProgram(p);
+    if (!gl.getProgramParameter(p, gl.LINK_STATUS)) throw new Error('link: ' + gl.getProgramInfoLog(p));
+    return p;
+}
+
+/// A cube texture with every stored level, uploaded as stored (faces +X..-Z, rows from t = 0).
+function uploadCube(gl, cube) {
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_CUBE_MAP, tex);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.pixelStorei(gl.UNPACK_FLIP_Y_WEBGL, false);
+    const [internal, format, type] = cube.format.gl.map((n) => gl[n]);
+    if (cube.vkFormat === 109 && !gl.getExtension('OES_texture_float_linear'))
+        throw new Error('an RGBA32F chain needs OES_texture_float_linear to be filtered');
+    cube.levels.forEach((lv, l) => {
+        for (let f = 0; f < 6; ++f)
+            gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, l, internal, lv.size, lv.size, 0, format, type, lv.faces[f]);
+    });
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_BASE_LEVEL, 0);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAX_LEVEL, cube.levels.length - 1);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MIN_FILTER, gl.LINEAR_MIPMAP_LINEAR);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    for (const w of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(gl.TEXTURE_CUBE_MAP, w, gl.CLAMP_TO_EDGE);
+    return tex;
+}
+
+/// The DFG table as RGBA32F (exact floats) when float filtering exists, else RGBA16F.
+function uploadLut(gl, dfg) {
+    const n = dfg.size, c = dfg.channels;
+    const rgba = new Float32Array(4 * n * n);
+    for (let i = 0; i < n * n; ++i) {
+        for (let k = 0; k < 4; ++k) rgba[4 * i + k] = k < c ? dfg.values[c * i + k] : (k === 3 ? 1 : 0);
+    }
+    const floatLinear = !!gl.getExtension('OES_texture_float_linear');
+    const tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    gl.texImage2D(gl.TEXTURE_2D, 0, floatLinear ? gl.RGBA32F : gl.RGBA16F, n, n, 0, gl.RGBA, gl.FLOAT, rgba);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    return { tex, format: floatLinear ? 'RGBA32F' : 'RGBA16F' };
+}
+
+class Renderer {
+    constructor(canvas, glsl, fragment) {
+        const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true, alpha: false, premultipliedAlpha: false });
+        if (!gl) throw new Error('WebGL2 is not available');
+        this.gl = gl;
+        this.canvas = canvas;
+        this.program = compile(gl, VERTEX, HEADER + glsl + '\n' + fragment);
+        this.vao = gl.createVertexArray();
+        this.u = (name) => gl.getUniformLocation(this.program, name);
+    }
+
+    setBake(bake) {
+        const gl = this.gl;
+        this.bake = bake;
+        this.rt = runtimeOf(bake);
+        this.chainTex = uploadCube(gl, bake.chain);
+        const lut = uploadLut(gl, bake.dfg);
+        this.lutTex = lut.tex;
+        this.lutFormat = lut.format;
+        this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance) : this.chainTex;
+        const shc = bake.sh && bake.sh.irradiance_over_pi_shader ? bake.sh.irradiance_over_pi_shader : [];
+        this.sh = new Float32Array(27);
+        for (let k = 0; k < Math.min(9, shc.length); ++k) for (let ch = 0; ch < 3; ++ch) this.sh[3 * k + ch] = shc[k][ch];
+        const src = bake.report && bake.report.source;
+        const mean = src && Number.isFinite(src.mean_luminance) ? src.mean_luminance : meanLuminance(bake.chain, 0) || 1;
+        // stage_preview.cpp: exposure = float(0.6 / max(mean, 1e-6)).
+        this.exposure = Math.fround(0.6 / Math.max(mean, 1e-6));
+        this.light = src && src.brightest_direction ? src.brightest_direction : [0, 1, 0];
+        // ibl-bake's preview_ss: 2 x 2 at --quality low, 4 x 4 otherwise.
+        const quality = bake.report && bake.report.options && bake.report.options.quality;
+        this.previewSs = quality === 'low' ? 2 : 4;
+    }
+
+    /// Draws into the canvas at its current size. view: { mode, roughness, ev, lookup, multiscatter,
+    /// light, ss, yaw, pitch }.
+    draw(view) {
+        const gl = this.gl, rt = this.rt, u = this.u;
+        const w = this.canvas.width, h = this.canvas.height;
+        gl.viewport(0, 0, w, h);
+        gl.useProgram(this.program);
+        gl.bindVertexArray(this.vao);
+        gl.activeTexture(gl.TEXTURE0);
+        gl.bindTexture(gl.TEXTURE_CUBE_MAP, this.chainTex);
+        gl.activeTexture(gl.TEXTURE1);
+        gl.bindTexture(gl.TEXTURE_2D, this.lutTex);
+        gl.activeTexture(gl.TEXTURE2);
+        gl.bindTexture(gl.TEXTURE_CUBE_MAP, this.irrTex);
+        gl.uniform1i(u('u_chain'), 0);
+        gl.uniform1i(u('u_lut'), 1);
+        gl.uniform1i(u('u_irradiance'), 2);
+        gl.uniform3fv(u('u_sh[0]'), this.sh);
+        gl.uniform1i(u('u_diffuse'), rt.diffuse === 'sh' ? 1 : rt.diffuse === 'irradiance_map' && this.bake.irradiance ? 2 : 0);
+        const spec = view.lookup === 'textbook' ? { weight: 'lod', interpolation: 'linear' }
+                   : view.lookup === 'log-geometric' ? { weight: 'log', interpolation: 'geometric' } : rt.spec;
+        gl.uniform4i(u('u_spec_levels'), rt.virtualLevels, rt.firstLevel, rt.stored, rt.mapping);
+        gl.uniform3i(u('u_spec_rule'), WEIGHT[spec.weight] ?? 2, INTERP[spec.interpolation] ?? 2, view.multiscatter === false ? 0 : 1);
+        gl.uniform1f(u('u_spec_exponent'), spec.weight_exponent ?? 2.0);
+        gl.uniform3i(u('u_dfg_layout'), ...rt.layout);
+        gl.uniform2f(u('u_size'), w, h);
+        gl.uniform1f(u('u_exposure'), this.exposure * Math.pow(2, view.ev || 0));
+        gl.uniform1i(u('u_mode'), view.mode);
+        gl.uniform1f(u('u_roughness'), view.roughness ?? 0.25);
+        let cam, eye = [0, 0, 0], offset = [1.15, 0, 0], tanHalf;
+        if (view.mode === 0) {
+            cam = previewCamera(this.light);
+            tanHalf = Math.tan(0.5 * 90 * Math.PI / 180);
+            gl.uniform1i(u('u_ss'), this.previewSs);
+        } else {
+            const base = previewCamera(this.light);
+            const yaw0 = Math.atan2(base.fwd[0], -base.fwd[2]);
+            const yaw = yaw0 + (view.yaw || 0), pitch = view.pitch || 0;
+            const fwd = [Math.sin(yaw) * Math.cos(pitch), Math.sin(pitch), -Math.cos(yaw) * Math.cos(pitch)];
+            const right = [Math.cos(yaw), 0, Math.sin(yaw)];
+            const up = [right[1] * fwd[2] - right[2] * fwd[1], right[2] * fwd[0] - right[0] * fwd[2], right[0] * fwd[1] - right[1] * fwd[0]];
+            cam = { fwd, right, up };
+            eye = fwd.map((x) => -5.5 * x);
+            offset = base.right.map((x) => 1.15 * x);
+            tanHalf = Math.tan(0.5 * 60 * Math.PI / 180);
+            gl.uniform1i(u('u_ss'), view.ss || 1);
+        }
+        gl.uniform3fv(u('u_fwd'), cam.fwd);
+        gl.uniform3fv(u('u_right'), cam.right);
+        gl.uniform3fv(u('u_up'), cam.up);
+        gl.uniform3fv(u('u_eye'), eye);
+        gl.uniform3fv(u('u_sphere_offset'), offset);
+        gl.uniform1f(u('u_tan_half_fov'), tanHalf);
+        gl.uniform3fv(u('u_light_dir'), this.light);
+        // The optional light: irradiance pi x the mean radiance (a light as bright as the whole sky).
+        const e = view.light ? Math.PI / this.exposure * 0.6 : 0;
+        gl.uniform3f(u('u_light_irradiance'), e, e, e);
+        gl.drawArrays(gl.TRIANGLES, 0, 3);
+    }
+
+    /// The canvas as RGB bytes, top row first.
+    readRgb() {
+        const gl = this.gl, w = this.canvas.width, h = this.canvas.height;
+        const px = new Uint8Array(4 * w * h);
+        gl.readPixels(0, 0, w, h, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        const rgb = new Uint8Array(3 * w * h);
+        for (let y = 0; y < h; ++y)
+            for (let x = 0; x < w; ++x)
+                for (let c = 0; c < 3; ++c) rgb[3 * (y * w + x) + c] = px[4 * ((h - 1 - y) * w + x) + c];
+        return rgb;
+    }
+
+    info() {
+        const gl = this.gl;
+        return {
+            renderer: rendererName(gl),
+            version: gl.getParameter(gl.VERSION),
+            chain_format: this.bake.chain.format.name,
+            chain_levels: this.bake.chain.levels.map((l) => l.size),
+            lut_texture: this.lutFormat,
+            lut_size: this.bake.dfg.size,
+            exposure: this.exposure,
+            preview_ss: this.previewSs,
+            runtime: this.rt,
+        };
+    }
+}
+
+/// The GL renderer's name, unmasked where the browser allows it (e.g. "SwiftShader ...").
+function rendererName(gl) {
+    const ext = gl.getExtension('WEBGL_debug_renderer_info');
+    return ext ? gl.getParameter(ext.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER);
+}
+
+function toBase64(bytes) {
+    let s = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
+    return btoa(s);
+}
+
+async function post(result) {
+    const url = params.get('report');
+    if (!url) return;
+    await fetch(url, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(result) });
+}
+
+// ---- test modes ------------------------------------------------------------------------------------
+
+async function runPreviewTest() {
+    const bake = await loadBake(urlSource(params.get('bake')));
+    const canvas = document.getElementById('view');
+    canvas.width = 640;
+    canvas.height = 256;
+    const r = new Renderer(canvas, await libraryGlsl(), await fetchText('viewer.frag.glsl'));
+    r.setBake(bake);
+    r.draw({ mode: 0 });
+    r.gl.finish();
+    await post({ kind: 'preview', width: 640, height: 256, rgb: toBase64(r.readRgb()), info: r.info() });
+}
+
+async function runNumericTest() {
+    const canvas = document.getElementById('view');
+    const gl = canvas.getContext('webgl2');
+    if (!gl) throw new Error('WebGL2 is not available');
+    if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to read float results');
+    const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('numeric.frag.glsl')));
+    const W = 64, H = 16;
+    const fb = gl.createFramebuffer(), tex = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, W, H, 0, gl.RGBA, gl.FLOAT, null);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+    gl.viewport(0, 0, W, H);
+    gl.useProgram(program);
+    gl.bindVertexArray(gl.createVertexArray());
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    const out = new Float32Array(4 * W * H);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.FLOAT, out);
+    await post({ kind: 'numeric', width: W, height: H, values: Array.from(out), renderer: rendererName(gl) });
+}
+
+// ---- interactive viewer ----------------------------------------------------------------------------
+
+async function runViewer() {
+    const canvas = document.getElementById('view');
+    const renderer = new Renderer(canvas, await libraryGlsl(), await fetchText('viewer.frag.glsl'));
+    const el = (id) => document.getElementById(id);
+    const view = { mode: 1, roughness: 0.25, ev: 0, lookup: 'bake', multiscatter: true, light: false, ss: 1, yaw: 0, pitch: 0 };
+    let ready = false, pending = false;
+    const redraw = () => {
+        if (!ready || pending) return;
+        pending = true;
+        requestAnimationFrame(() => {
+            pending = false;
+            const grid = view.mode === 0;
+            const dpr = grid ? 1 : Math.min(window.devicePixelRatio || 1, 2);
+            canvas.width = grid ? 640 : Math.floor(canvas.clientWidth * dpr);
+            canvas.height = grid ? 256 : Math.floor(canvas.clientHeight * dpr);
+            canvas.style.width = grid ? '640px' : '100vw';
+            canvas.style.height = grid ? '256px' : '100vh';
+            canvas.style.margin = grid ? '8px 0 0 400px' : '0'; // beside the panel
+            renderer.draw(view);
+        });
+    };
+    const bind = (id, key, parse, show) => {
+        const input = el(id);
+        const initial = params.get(id); // ?roughness=0.5&ev=1&lookup=textbook&grid=1 ...
+        if (initial !== null) {
+            if (input.type === 'checkbox') input.checked = initial === '1';
+            else input.value = initial;
+        }
+        const update = () => { view[key] = parse(input); if (show) el(id + '_v').textContent = show(view[key]); redraw(); };
+        input.addEventListener('input', update);
+        update();
+    };
+    bind('roughness', 'roughness', (i) => +i.value, (v) => v.toFixed(2));
+    bind('ev', 'ev', (i) => +i.value, (v) => (v >= 0 ? '+' : '') + v.toFixed(1));
+    bind('lookup', 'lookup', (i) => i.value);
+    bind('scatter', 'multiscatter', (i) => i.value === '1');
+    bind('grid', 'mode', (i) => (i.checked ? 0 : 1));
+    bind('light', 'light', (i) => i.checked);
+    bind('ss', 'ss', (i) => +i.value);
+    let drag = null;
+    canvas.addEventListener('pointerdown', (e) => { drag = [e.clientX, e.clientY, view.yaw, view.pitch]; canvas.setPointerCapture(e.pointerId); });
+    canvas.addEventListener('pointermove', (e) => {
+        if (!drag) return;
+        view.yaw = drag[2] + (e.clientX - drag[0]) * 0.005;
+        view.pitch = Math.max(-1.5, Math.min(1.5, drag[3] + (e.clientY - drag[1]) * 0.005));
+        redraw();
+    });
+    canvas.addEventListener('pointerup', () => { drag = null; });
+    window.addEventListener('resize', redraw);
+    const open = async (src) => {
+        statusEl.textContent = '';
+        try {
+            const bake = await loadBake(src);
+            renderer.setBake(bake);
+            ready = true;
+            const i = renderer.info();
+            log(`${bake.label}: chain ${i.chain_levels.join('/')} ${i.chain_format}, LUT ${i.lut_size}^2 (${i.lut_texture}), ` +
+                `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, diffuse ${renderer.rt.diffuse}\n${i.renderer}`);
+            redraw();
+        } catch (e) {
+            log(String(e.message || e));
+        }
+    };
+    el('folder').addEventListener('change', (e) => open(fileSource(e.target.files)));
+    if (params.get('bake')) await open(urlSource(params.get('bake')));
+    else log('choose a bake folder (ibl-bake --out DIR), or open this page with ?bake=URL');
+}
+
+async function main() {
+    if (testMode) document.body.classList.add('test');
+    try {
+        if (testMode === 'preview') await runPreviewTest();
+        else if (testMode === 'numeric') await runNumericTest();
+        else await runViewer();
+    } catch (e) {
+        log(String(e.stack || e));
+        if (testMode) await post({ kind: 'error', error: String(e.stack || e) });
+    }
+}
+
+window.addEventListener('error', (e) => { if (testMode) post({ kind: 'error', error: String(e.message) }); });
+main();
