@@ -12,7 +12,7 @@
 //
 // Files read from the folder: specular.ktx2 (required), dfg.hpp (required: the exact float table
 // in the layout of report.json), report.json (plan.runtime: the lookup conventions; source: the
-// exposure and camera of the preview), sh.json ("irradiance_over_pi_shader") or irradiance.ktx2.
+// exposure and camera of the preview), sh.json ("irradiance_over_pi_shader", or its "_windowed" form) or irradiance.ktx2.
 
 import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
 
@@ -209,7 +209,8 @@ class Renderer {
         this.lutTex = lut.tex;
         this.lutFormat = lut.format;
         this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance) : this.chainTex;
-        const shc = bake.sh && bake.sh.irradiance_over_pi_shader ? bake.sh.irradiance_over_pi_shader : [];
+        // The renderer's coefficients: the windowed ones when sh.json has them ("radiance" is raw).
+        const shc = !bake.sh ? [] : bake.sh.irradiance_over_pi_shader_windowed || bake.sh.irradiance_over_pi_shader || [];
         this.sh = new Float32Array(27);
         for (let k = 0; k < Math.min(9, shc.length); ++k) for (let ch = 0; ch < 3; ++ch) this.sh[3 * k + ch] = shc[k][ch];
         const src = bake.report && bake.report.source;
