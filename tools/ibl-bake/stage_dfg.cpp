@@ -99,10 +99,10 @@ std::vector<file_out> dfg_stage::files() const {
             {"dfg.hpp", [this](const std::string& p) {
                  write_text(p, ibl::dfg_lut_header(*lut_, "dfg_lut", "ibl_baked",
                                                    std::string(bake_model::name) + ", exact quadrature (ibl-bake --quality " +
-                                                       quality_ + "), layout " +
-                                                       (layout_.edge_aligned ? "cbrt(n.v) x sqrt(r), edge-aligned: sample at "
-                                                                               "ibl::dfg_lut_coord"
-                                                                             : "uniform, texel centres")));
+                                                       quality_ + ")",
+                                                   layout_.edge_aligned ? "n.v = (i / (size - 1))^3, roughness = (j / (size - 1))^2 "
+                                                                          "(edge-aligned; sample at ibl::dfg_lut_coord)"
+                                                                        : ""));
              }}};
 }
 

@@ -28,10 +28,13 @@
 namespace ibl {
 
 /// Writes `lut` as a C++ header. `name` is the array's identifier, `ns` its namespace (empty:
-/// global), `description` goes into the leading comment (e.g. the model and the method).
+/// global), `description` goes into the leading comment (e.g. the model and the method),
+/// `texel_rule` replaces the comment's rule for texel (i, j) (default: the texel centres of
+/// integrate/dfg_lut.hpp; a remapped table, ibl/lookup.hpp, states its own).
 /// Throws std::invalid_argument unless lut.valid() (data of exactly size^2 * channels floats).
 inline void write_dfg_lut_header(std::ostream& os, const dfg_lut& lut, std::string_view name,
-                                 std::string_view ns = "", std::string_view description = "") {
+                                 std::string_view ns = "", std::string_view description = "",
+                                 std::string_view texel_rule = "") {
     if (!lut.valid())
         throw std::invalid_argument("ibl::write_dfg_lut_header: lut of size " + std::to_string(lut.size) + ", " +
                                     std::to_string(lut.channels) + " channels holds " +
@@ -43,8 +46,9 @@ inline void write_dfg_lut_header(std::ostream& os, const dfg_lut& lut, std::stri
     os << ".\n// " << lut.size << " x " << lut.size << " texels, " << lut.channels
        << " channels (A = scale of F0, B = scale of F90" << (lut.channels > 2 ? ", k = (1 - E)/E" : "")
        << "), float32, interleaved.\n"
-       << "// Texel (i, j): n.v = (i + 0.5) / size, roughness = (j + 0.5) / size; row 0 (smallest\n"
-       << "// roughness) first: value = " << name << "[(j * size + i) * channels + c].\n\n";
+       << "// Texel (i, j): "
+       << (texel_rule.empty() ? std::string_view("n.v = (i + 0.5) / size, roughness = (j + 0.5) / size") : texel_rule)
+       << "; row 0 (smallest\n// roughness) first: value = " << name << "[(j * size + i) * channels + c].\n\n";
     if (!ns.empty()) os << "namespace " << ns << " {\n\n";
     os << "inline constexpr unsigned " << name << "_size = " << lut.size << ";\n"
        << "inline constexpr unsigned " << name << "_channels = " << lut.channels << ";\n"
@@ -67,9 +71,9 @@ inline void write_dfg_lut_header(std::ostream& os, const dfg_lut& lut, std::stri
 
 /// The header as a string (see write_dfg_lut_header).
 inline std::string dfg_lut_header(const dfg_lut& lut, std::string_view name, std::string_view ns = "",
-                                  std::string_view description = "") {
+                                  std::string_view description = "", std::string_view texel_rule = "") {
     std::ostringstream os;
-    write_dfg_lut_header(os, lut, name, ns, description);
+    write_dfg_lut_header(os, lut, name, ns, description, texel_rule);
     return os.str();
 }
 
