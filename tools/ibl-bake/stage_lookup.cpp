@@ -84,7 +84,7 @@ private:
             std::vector<dvec3> out(d.size());
             ctx.ex(d.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i)
-                    out[i] = ibl::reference_ld_sky(ctx.src.sky, d[i], r, ctx.qs.sky_ref_samples, ctx.qs.sun_cap_nodes);
+                    out[i] = ibl::reference_ld_sky(ctx.src.sky, d[i], r, std::max(ctx.qs.sky_ref_samples / 4, 256u), ctx.qs.sun_cap_nodes);
             });
             return out;
         }
