@@ -82,6 +82,19 @@ std::string path_value(const std::string& option, const std::string& v) {
     return v;
 }
 
+/// The conventions of an engine (docs/ibl-bake.md, "Presets").
+void apply_preset(bake_options& o, const std::string& p) {
+    o.preset = p;
+    const bool engine = p != "default";
+    o.policy = p == "filament" ? "filament" : "linear";
+    o.specular_lookup = engine ? "textbook" : "default";
+    o.dfg_layout = engine ? "uniform" : "remapped";
+    o.dfg_channels = p == "filament" ? "filament" : "ab";
+    o.mirror = p == "filament";
+    o.extract_sun = engine ? "off" : "auto";
+    o.irradiance_size = engine ? 0 : 32;
+}
+
 using handler = std::function<void(bake_options&, const std::string&)>;
 struct option_spec {
     bool takes_value;
@@ -94,6 +107,9 @@ const std::map<std::string, option_spec>& option_table() {
         {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
         {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
         {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
+        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {"default", "filament", "gltf"})); }}},
+        {"--policy", {true, [](bake_options& o, const std::string& v) { o.policy = choice("--policy", v, {"linear", "filament"}); }}},
+        {"--mirror", {false, [](bake_options& o, const std::string&) { o.mirror = true; }}},
         {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
         {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
@@ -224,6 +240,9 @@ std::string usage_text() {
            "  --sh-window W      auto (default) | none | Hanning width W: applied to irradiance and shader SH\n"
            "  --irradiance-size N  irradiance map face (default 32), 0 = none\n"
            "  --extract-sun S    auto (default) | on | off: a compact dominant source becomes lights.json\n"
+           "  --preset P         default | filament | gltf: an engine's conventions (options after it override)\n"
+           "  --policy P         linear (default) | filament: roughness <-> lod of the chain\n"
+           "  --mirror           mirror the environment (x -> -x)\n"
            "  --sheen            also the Charlie sheen chain and the sheen albedo LUT\n"
            "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
            "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"

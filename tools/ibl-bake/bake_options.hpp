@@ -25,6 +25,10 @@
 //   --sh-window W       auto (default) | none | a Hanning width > 0 (applies to irradiance / shader)
 //   --irradiance-size N irradiance map face 1..256 (default 32), 0 = no map (full bake)
 //   --extract-sun S     auto (default: extract a compact dominant source as a disk light) | on | off
+//   --preset P          default | filament | gltf: the conventions of an engine (docs/ibl-bake.md);
+//                       options after it override what it sets
+//   --policy P          linear (default) | filament: the roughness <-> lod mapping of the chain
+//   --mirror            mirror the environment (x -> -x), as Filament's cmgen does by default
 //   --sheen             also the sheen products (Charlie chain sheen_*.exr / sheen.ktx2, sheen_lut.exr)
 //   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
 //   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
@@ -71,7 +75,11 @@ struct bake_options {
     std::string sh_window = "auto";            ///< auto | none | a Hanning width W > 0
     int irradiance_size = 32;                  ///< --irradiance-size: face of the irradiance map (0: none)
     std::string extract_sun = "auto";
-    bool sheen = false;                        ///< --sheen: the Charlie sheen chain and LUT          ///< auto | on | off
+    bool sheen = false;                        ///< --sheen: the Charlie sheen chain and LUT
+    std::string preset = "default";            ///< default | filament | gltf (sets the fields below)
+    std::string policy = "linear";             ///< roughness <-> lod: linear | filament (lod = r (2 - r) ...)
+    std::string dfg_channels = "ab";           ///< ab: (A, B, k) | filament: (B, A + B, k) for mix(x, y, f0)
+    bool mirror = false;                       ///< the environment mirrored x -> -x (cmgen's default)          ///< auto | on | off
     std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
     std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)

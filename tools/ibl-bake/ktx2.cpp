@@ -283,7 +283,8 @@ cubemap_rgb32f cubemap_rgb32f::zeros(int size, int level_count) {
 }
 
 std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
-                                               const std::string& name, ktx2_clamp_counts* counts) {
+                                               const std::string& name, ktx2_clamp_counts* counts,
+                                               const std::vector<std::pair<std::string, std::string>>& metadata) {
     check_cube(cube, name);
     if (!known_format(std::uint32_t(format)))
         throw image_error(name, "unsupported KTX2 format " + std::to_string(std::uint32_t(format)));
@@ -292,9 +293,16 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
     const std::size_t tb = texel_bytes(format);
     const std::size_t dfd_offset = header_bytes + level_entry_bytes * L;
     const std::size_t kvd_offset = dfd_offset + dfd_total;
-    const std::string key = "KTXwriter";
-    const std::size_t kv_len = key.size() + 1 + writer.size() + 1;
-    const std::size_t kvd_length = align_up(4 + kv_len, 4);
+    // Key/value pairs sorted by key (the KTX2 rule): KTXwriter, then the caller's metadata.
+    std::vector<std::pair<std::string, std::string>> kv = metadata;
+    kv.emplace_back("KTXwriter", writer);
+    std::sort(kv.begin(), kv.end());
+    for (std::size_t i = 0; i < kv.size(); ++i)
+        if (kv[i].first.empty() || kv[i].first.find('\0') != std::string::npos || kv[i].second.find('\0') != std::string::npos ||
+            (i > 0 && kv[i].first == kv[i - 1].first))
+            throw image_error(name, "bad KTX2 key/value metadata key '" + kv[i].first + "'");
+    std::size_t kvd_length = 0;
+    for (const auto& [k, v] : kv) kvd_length += align_up(4 + k.size() + 1 + v.size() + 1, 4);
     std::size_t pos = kvd_offset + kvd_length;
 
     // Level placement, smallest level first.
@@ -352,9 +360,14 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
     }
 
     // Key/value data.
-    put32(b, kvd_offset, std::uint32_t(kv_len));
-    std::memcpy(b.data() + kvd_offset + 4, key.c_str(), key.size() + 1);
-    std::memcpy(b.data() + kvd_offset + 4 + key.size() + 1, writer.c_str(), writer.size() + 1);
+    std::size_t at_kv = kvd_offset;
+    for (const auto& [k, v] : kv) {
+        const std::size_t len = k.size() + 1 + v.size() + 1;
+        put32(b, at_kv, std::uint32_t(len));
+        std::memcpy(b.data() + at_kv + 4, k.c_str(), k.size() + 1);
+        std::memcpy(b.data() + at_kv + 4 + k.size() + 1, v.c_str(), v.size() + 1);
+        at_kv += align_up(4 + len, 4);
+    }
 
     // Texels.
     ktx2_clamp_counts seen;
@@ -389,8 +402,8 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
 }
 
 void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format,
-                        const std::string& writer) {
-    write_file_atomic(path, encode_ktx2_cubemap(cube, format, writer, path));
+                        const std::string& writer, const std::vector<std::pair<std::string, std::string>>& metadata) {
+    write_file_atomic(path, encode_ktx2_cubemap(cube, format, writer, path, nullptr, metadata));
 }
 
 // ---- reader ------------------------------------------------------------------------------------

@@ -118,10 +118,14 @@ struct ktx2_clamp_counts {
 std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format,
                                                const std::string& writer = "ibl-bake",
                                                const std::string& name = "<ktx2>",
-                                               ktx2_clamp_counts* counts = nullptr);
+                                               ktx2_clamp_counts* counts = nullptr,
+                                               const std::vector<std::pair<std::string, std::string>>& metadata = {});
 /// encode_ktx2_cubemap + write_file_atomic.
+/// metadata: extra key/value pairs (UTF-8 keys without NUL, not starting with "KTX"; written sorted
+/// by key after KTXwriter's place in that order).
 void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format,
-                        const std::string& writer = "ibl-bake");
+                        const std::string& writer = "ibl-bake",
+                        const std::vector<std::pair<std::string, std::string>>& metadata = {});
 
 /// Parsed header and indices of a KTX2 file (for tests and verification).
 struct ktx2_level {

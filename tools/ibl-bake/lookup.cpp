@@ -154,7 +154,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
 product_view baked_folder::view() const {
     product_view v;
     v.chain = has_chain ? &chain : nullptr;
-    v.policy = ibl::roughness_mip_policy::linear();
+    v.policy = filament_policy ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
     v.virtual_levels = virtual_levels;
     v.first_level = first_level;
     v.lut = has_lut ? &lut : nullptr;
@@ -171,6 +171,7 @@ baked_folder load_baked_folder(const std::string& dir) {
     const json_value& rt = member(member(report, "plan", rp), "runtime", rp);
     baked_folder b;
     b.virtual_levels = int(member(rt, "virtual_levels", rp).number);
+    b.filament_policy = member(rt, "policy", rp).string == "filament";
     b.first_level = int(member(rt, "first_level", rp).number);
     if (member(rt, "stored_levels", rp).number > 0) {
         b.chain = cube_from_ktx2(dir + "/specular.ktx2");
@@ -178,8 +179,14 @@ baked_folder load_baked_folder(const std::string& dir) {
     }
     b.specular = specular_lookup_named(member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? "textbook" : "default");
     b.dfg_layout = dfg_layout_named(member(member(rt, "dfg_layout", rp), "edge_aligned", rp).boolean ? "remapped" : "uniform");
+    b.specular.mapping = b.filament_policy ? ibl::roughness_mapping::filament : ibl::roughness_mapping::linear;
     if (member(rt, "dfg_size", rp).number > 0) {
         b.lut = lut_from_exr(dir + "/dfg.exr", int(member(rt, "dfg_channels", rp).number));
+        if (const json_value* ch = rt.find("dfg_channels_layout"); ch && ch->string.rfind("B,", 0) == 0) // (B, A + B, k)
+            for (std::size_t k = 0; k + 1 < b.lut.data.size(); k += b.lut.channels) {
+                const float x = b.lut.data[k], y = b.lut.data[k + 1];
+                b.lut.data[k] = y - x, b.lut.data[k + 1] = x;
+            }
         b.has_lut = true;
     }
     if (fs_exists(dir + "/lights.json")) {

@@ -37,6 +37,7 @@ struct baked_folder {
     bool has_lut = false;
     diffuse_data diffuse;
     int virtual_levels = 1, first_level = 0;
+    bool filament_policy = false;
     ibl::specular_lookup_desc specular{};
     ibl::dfg_lut_layout dfg_layout{};
     std::optional<ibl::disk_light<double>> sun; ///< lights.json's sun, if any

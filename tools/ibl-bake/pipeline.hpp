@@ -54,6 +54,7 @@ struct source_env {
     std::unique_ptr<ibl::latlong<float>> map;  ///< lat-long inputs
     std::unique_ptr<ibl::cubemap<float>> cube; ///< cube inputs (full mip chain)
     std::string layout;                        ///< latlong, hcross, vcross, hstrip, vstrip, faces, ktx2
+    bool mirrored = false;                     ///< --mirror applied (x -> -x)
     read_report rr;
     std::size_t values_clamped = 0;            ///< values above radiance_clamp_bound (input_guard.hpp)
     int width = 0, height = 0;                 ///< of the input image (a cube input: its face size)

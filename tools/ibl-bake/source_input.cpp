@@ -2,7 +2,10 @@
 
 #include "source_input.hpp"
 
+#include <algorithm>
 #include <span>
+
+#include <ibl/env/cube_geometry.hpp>
 
 #include "cube_layout.hpp"
 #include "input_guard.hpp"
@@ -74,6 +77,47 @@ void read_source(const bake_options& opt, source_env& src) {
     src.width = img.width;
     src.height = img.height;
     src.map = std::make_unique<ibl::latlong<float>>(img.width, img.height, std::span<const float>(img.rgb), 1);
+    src.map->update_borders();
+}
+
+void mirror_source(source_env& src) {
+    src.mirrored = true;
+    if (src.analytic) {
+        src.sky.set_sun(dvec3(-src.sky.sun_dir.x, src.sky.sun_dir.y, src.sky.sun_dir.z), src.sky.sun_radiance, src.sky.sun_angular_radius);
+        return;
+    }
+    if (src.cube) {
+        const ibl::cubemap<float>& c = *src.cube;
+        const int n = c.size(0);
+        cube_faces f;
+        f.size = n;
+        for (int face = 0; face < 6; ++face) {
+            f.face[std::size_t(face)] = image_rgb32f(n, n);
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const dvec3 d = ibl::cube_texel_direction<double>(face, x, y, n);
+                    const ibl::cube_coord<double> m = ibl::cube_lookup(dvec3(-d.x, d.y, d.z));
+                    const int mx = std::clamp(int(m.s * n), 0, n - 1), my = std::clamp(int(m.t * n), 0, n - 1);
+                    const fvec3& v = c.texel(m.face, mx, my, 0);
+                    float* t = f.face[std::size_t(face)].texel(x, y);
+                    t[0] = v.x, t[1] = v.y, t[2] = v.z;
+                }
+        }
+        src.cube = std::make_unique<ibl::cubemap<float>>(cubemap_from_faces(f));
+        return;
+    }
+    // lat-long: u = 0.5 + atan2(z, x) / (2 pi); x -> -x gives u' = 1.5 - u (mod 1): column i -> (W/2 - 1 - i) mod W
+    const ibl::latlong<float>& m = *src.map;
+    const int w = m.width(0), h = m.height(0);
+    image_rgb32f img(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const int sx = ((w / 2 - 1 - x) % w + w) % w;
+            const fvec3 v = m.texel(sx, y, 0);
+            float* t = img.texel(x, y);
+            t[0] = v.x, t[1] = v.y, t[2] = v.z;
+        }
+    src.map = std::make_unique<ibl::latlong<float>>(w, h, std::span<const float>(img.rgb), 1);
     src.map->update_borders();
 }
 

@@ -17,4 +17,8 @@ namespace ibl_bake {
 /// Throws image_error naming the file.
 void read_source(const bake_options& opt, source_env& src);
 
+/// Mirrors the environment x -> -x (--mirror): the sky's sun, a lat-long's columns (u -> 1.5 - u),
+/// a cube input's texels (texel centres map onto texel centres). Exact: no resampling.
+void mirror_source(source_env& src);
+
 } // namespace ibl_bake

@@ -101,6 +101,7 @@ void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s,
 product_view baked_view(const bake_context& ctx) {
     product_view v;
     v.specular = specular_lookup_named(ctx.opt.specular_lookup);
+    v.specular.mapping = ctx.plan.specular.policy.mapping;
     v.dfg_layout = dfg_layout_named(ctx.opt.dfg_layout);
     v.chain = ctx.chain ? &*ctx.chain : nullptr;
     v.policy = ctx.plan.specular.policy;
@@ -133,7 +134,12 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
     if (src.cube) k = std::clamp(int(std::ceil(double(src.cube->size(0)) / double(n))), base_k, 32);
     else if (!src.analytic) k = std::clamp(int(std::ceil(double(src.width) / (4.0 * n))), base_k, 32);
     if (k_used) *k_used = src.cube && src.cube->size(0) == n ? 1 : k;
-    if (src.analytic) return ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), n, k, ex, 0);
+    if (src.analytic && !src.mirrored) return ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), n, k, ex, 0);
+    if (src.analytic) { // the mirrored sky, in float as the default one is baked
+        ibl::sky_environment<float> sky = ibl::make_default_sky<float>();
+        sky.set_sun(fvec3(src.sky.sun_dir), fvec3(src.sky.sun_radiance), float(src.sky.sun_angular_radius));
+        return ibl::bake_cubemap<float>(sky, n, k, ex, 0);
+    }
     if (src.cube) return src.cube->size(0) == n ? *src.cube : ibl::bake_cubemap<float>(*src.cube, n, k, ex, 0);
     return ibl::bake_cubemap<float>(*src.map, n, k, ex, 0);
 }

@@ -35,6 +35,7 @@ public:
         quality_ = ctx.qs.name;
         ctx.prog.begin("dfg lut");
         layout_ = dfg_layout_named(ctx.opt.dfg_layout);
+        filament_channels_ = ctx.opt.dfg_channels == "filament";
         ctx.lut = ibl::make_dfg_lut_exact<bake_model>(std::uint32_t(ctx.plan.dfg.size), layout_,
                                                       std::uint32_t(ctx.plan.dfg.channels), nodes_, ctx.ex);
         ms_ = ctx.prog.end();
@@ -80,6 +81,17 @@ private:
 
     const ibl::dfg_lut* lut_ = nullptr;
     ibl::dfg_lut_layout layout_{};
+    bool filament_channels_ = false; ///< files hold (B, A + B, k): mix(dfg.x, dfg.y, f0) = F0 A + B
+    /// The table as the files store it.
+    ibl::dfg_lut file_lut() const {
+        ibl::dfg_lut t = *lut_;
+        if (filament_channels_)
+            for (std::size_t k = 0; k + 1 < t.data.size(); k += t.channels) {
+                const float a = t.data[k], b = t.data[k + 1];
+                t.data[k] = b, t.data[k + 1] = a + b;
+            }
+        return t;
+    }
     ibl::dfg_lookup_report lookup_, lookup_half_;
     ibl::dfg_quadrature_nodes nodes_{};
     std::string quality_;
@@ -90,16 +102,20 @@ private:
 std::vector<file_out> dfg_stage::files() const {
     return {{"dfg.exr",
              [this](const std::string& p) {
-                 image_rgb32f d(int(lut_->size), int(lut_->size));
-                 for (std::uint32_t j = 0; j < lut_->size; ++j)
-                     for (std::uint32_t i = 0; i < lut_->size; ++i)
-                         for (std::uint32_t c = 0; c < lut_->channels && c < 3; ++c) d.texel(int(i), int(j))[c] = lut_->at(i, j, c);
+                 const ibl::dfg_lut t = file_lut();
+                 image_rgb32f d(int(t.size), int(t.size));
+                 for (std::uint32_t j = 0; j < t.size; ++j)
+                     for (std::uint32_t i = 0; i < t.size; ++i)
+                         for (std::uint32_t c = 0; c < t.channels && c < 3; ++c) d.texel(int(i), int(j))[c] = t.at(i, j, c);
                  write_exr(p, d);
              }},
             {"dfg.hpp", [this](const std::string& p) {
-                 write_text(p, ibl::dfg_lut_header(*lut_, "dfg_lut", "ibl_baked",
+                 write_text(p, ibl::dfg_lut_header(file_lut(), "dfg_lut", "ibl_baked",
                                                    std::string(bake_model::name) + ", exact quadrature (ibl-bake --quality " +
-                                                       quality_ + ")",
+                                                       quality_ + ")" +
+                                                       (filament_channels_ ? "; channels stored as (B, A + B, k): "
+                                                                             "specular = LD mix(dfg.x, dfg.y, F0)"
+                                                                           : ""),
                                                    layout_.edge_aligned ? "n.v = (i / (size - 1))^3, roughness = (j / (size - 1))^2 "
                                                                           "(edge-aligned; sample at ibl::dfg_lut_coord)"
                                                                         : ""));

@@ -43,12 +43,14 @@ public:
         const auto t0 = std::chrono::steady_clock::now();
         for (int k = 1; k <= 20; ++k) roughness_.push_back(0.05 * k);
         dirs_ = ibl::lookup_error_directions(ctx.qs.ref_grid, ctx.light);
-        const ibl::specular_lookup_desc chosen = specular_lookup_named(ctx.opt.specular_lookup);
+        ibl::specular_lookup_desc chosen = specular_lookup_named(ctx.opt.specular_lookup);
+        chosen.mapping = ctx.plan.specular.policy.mapping;
         const std::vector<unsigned char> bytes =
             encode_ktx2_cubemap(ktx_cube(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
         const ibl::cubemap<float> stored = cube_from_ktx2_bytes(bytes, "specular.ktx2");
         const bool textbook = ctx.opt.specular_lookup == "textbook";
-        const ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "default" : "textbook");
+        ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "default" : "textbook");
+        other.mapping = chosen.mapping;
         const std::string chosen_name = textbook ? "textbook (chosen)" : "log-geometric (chosen)";
         const std::string stored_name = "as stored in specular.ktx2 (" + ctx.opt.ktx2_format + ")";
         if (ctx.sun) { // the chain is the residual: measure what the runtime adds up (with the sun) against the whole

@@ -73,7 +73,7 @@ public:
     void run(bake_context& ctx) override {
         ctx.set.levels = ctx.opt.levels > 0 ? ctx.opt.levels : auto_levels(ctx.opt.size);
         ctx.set.max_base_size = ctx.opt.size;
-        ctx.set.policy = ibl::roughness_mip_policy::linear();
+        ctx.set.policy = ctx.opt.policy == "filament" ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
         ctx.full = tool_full_plan(ctx.set, ctx.qs, ctx.opt.lut_size);
         ctx.scene_mode = !ctx.opt.scene.empty();
         if (ctx.scene_mode) {
@@ -97,6 +97,10 @@ public:
         levels_ = ctx.set.levels;
         specular_lookup_ = ctx.opt.specular_lookup;
         sheen_ = ctx.opt.sheen;
+        policy_ = ctx.opt.policy;
+        preset_ = ctx.opt.preset;
+        dfg_channels_ = ctx.opt.dfg_channels;
+        mirror_ = ctx.opt.mirror;
         runtime_diffuse_ = ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map || (!ctx.scene_mode && ctx.opt.irradiance_size > 0)
                                ? "irradiance_map"
                                : diffuse_name(ctx.plan.diffuse.kind);
@@ -117,7 +121,8 @@ private:
     std::vector<std::string> omitted_;
     std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_, runtime_diffuse_;
     int levels_ = 1;
-    bool sheen_ = false;
+    bool sheen_ = false, mirror_ = false;
+    std::string policy_, preset_, dfg_channels_;
 };
 
 std::vector<std::string> plan_stage::notes_before() const {
@@ -156,10 +161,14 @@ void plan_stage::report(json_writer& j) const {
         j.key("error_target").value(plan_.error_target);
         j.key("diffuse_error_target").value(plan_.diffuse_error_target);
     }
-    j.key("runtime_lookup").value("lod = r * " + std::to_string(levels_ - 1) + " - " + std::to_string(plan_.specular.first_level) +
-                                  " (linear policy over the virtual chain, minus the first stored level), clamped to the stored levels");
+    j.key("runtime_lookup").value(std::string(policy_ == "filament" ? "lod = r (2 - r) * " : "lod = r * ") + std::to_string(levels_ - 1) +
+                                  " - " + std::to_string(plan_.specular.first_level) +
+                                  " (the policy over the virtual chain, minus the first stored level), clamped to the stored levels");
     j.key("runtime").begin_object(); // what a loader (and ibl-bake --lookup) needs
-    j.key("policy").value("linear");
+    j.key("policy").value(policy_);
+    j.key("preset").value(preset_);
+    j.key("dfg_channels_layout").value(dfg_channels_ == "filament" ? "B, A + B, k (mix(dfg.x, dfg.y, f0))" : "A, B, k");
+    j.key("mirrored").value(mirror_);
     j.key("virtual_levels").value(plan_.specular.virtual_levels);
     j.key("first_level").value(plan_.specular.first_level);
     j.key("stored_levels").value(int(plan_.specular.levels.size()));

@@ -46,6 +46,7 @@ public:
     void run(bake_context& ctx) override {
         if (!ctx.opt.input.empty()) read_input(ctx);
         else ctx.src.name = "built-in sky + sun (ibl::make_default_sky)";
+        if (ctx.opt.mirror) mirror_source(ctx.src);
         size_ = ctx.plan.source_size;
         ctx.prog.begin("source cube");
         ctx.source = bake_source(ctx.src, size_, ctx.qs.bake_k, ctx.ex, &k_);
@@ -71,6 +72,7 @@ public:
         j.begin_object();
         j.key("kind").value(src_->analytic ? "analytic" : src_->cube ? "cube" : "latlong");
         if (!src_->analytic) j.key("layout").value(src_->layout);
+        j.key("mirrored").value(src_->mirrored);
         j.key("name").value(src_->name);
         if (!src_->analytic) {
             j.key("format").value(src_->rr.format);

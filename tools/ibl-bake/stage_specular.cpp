@@ -27,6 +27,23 @@ namespace {
 
 constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 reference texel mean
 
+/// What a loader needs, in the KTX2's key/value data: the level -> roughness mapping, the first
+/// stored level of the virtual chain, the policy, the lookup and the preset.
+std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_context& ctx) {
+    const ibl::specular_plan& sp = ctx.plan.specular;
+    std::string r;
+    for (const auto& l : sp.levels) {
+        if (!r.empty()) r.push_back(' ');
+        r.append(fmt("%.9g", l.roughness));
+    }
+    return {{"ibl.first_level", std::to_string(sp.first_level)},
+            {"ibl.level_roughness", r},
+            {"ibl.policy", ctx.opt.policy == "filament" ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r"},
+            {"ibl.preset", ctx.opt.preset},
+            {"ibl.specular_lookup", ctx.opt.specular_lookup},
+            {"ibl.virtual_levels", std::to_string(sp.virtual_levels)}};
+}
+
 struct level_check {
     int level = 0, virtual_level = 0, size = 0;
     double roughness = 0.0;
@@ -54,6 +71,7 @@ public:
         analytic_ = ctx.src.analytic;
         qs_ = ctx.qs;
         format_ = ctx.opt.ktx2_format;
+        metadata_ = chain_metadata(ctx);
         layouts_ = ctx.opt.layouts;
         quant_ = ktx2_quantisation_report(ktx_cube(*chain_), ktx2_format_named(format_));
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
@@ -79,6 +97,7 @@ private:
     std::string format_;
     std::vector<std::string> layouts_;
     std::vector<ktx2_quantisation_level> quant_;
+    std::vector<std::pair<std::string, std::string>> metadata_;
     quality_settings qs_{};
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
     std::vector<level_check> checks_;
@@ -181,7 +200,7 @@ std::vector<file_out> specular_stage::files() const {
             f.push_back({base + "octahedral.exr", [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l)); }});
     }
     f.push_back({"specular.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, ktx_cube(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                     write_ktx2_cubemap(p, ktx_cube(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string(), metadata_);
                  }});
     return f;
 }

@@ -1,0 +1,108 @@
+// tools/ibl-bake/tests/test_presets.cpp — --preset filament and gltf change exactly the conventions
+// docs/ibl-bake.md lists, each checked here against a default bake told the same conventions by
+// hand (so the products must agree): filament's mirror (x -> -x) moves the sun to -x, its chain
+// follows lod = r (2 - r) (level roughness 1 - sqrt(1 - l/(V - 1))), its DFG table stores
+// (B, A + B) so that mix(dfg.x, dfg.y, F0) = F0 A + B, and its KTX2 records what a loader needs;
+// gltf keeps the linear chain and the (A, B) texel-centre table. --lookup answers the same DFG
+// queries for both tables.
+
+#include <doctest/doctest.h>
+
+#include "image_io.hpp"
+#include "json_value.hpp"
+#include "ktx2.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <map>
+#include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+using namespace ibl_bake;
+
+namespace {
+
+const std::string tool = IBL_BAKE_TOOL;
+
+std::string slurp(const std::string& path) {
+    std::ifstream f(path, std::ios::binary);
+    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
+}
+
+int sh(const std::string& cmd) {
+    const int st = std::system(cmd.c_str());
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+struct scratch {
+    fs::path path;
+    scratch() : path(fs::temp_directory_path() / ("ibl_bake_preset_tests_" + std::to_string(::getpid()))) {
+        fs::remove_all(path);
+        fs::create_directories(path);
+    }
+    ~scratch() {
+        std::error_code ec;
+        fs::remove_all(path, ec);
+    }
+    std::string operator/(const std::string& n) const { return (path / n).string(); }
+};
+
+} // namespace
+
+TEST_CASE("presets: filament and gltf change the documented conventions") {
+    scratch s;
+    const std::string base = tool + " --quiet --size 32 --quality low --lut-size 32 ";
+    REQUIRE(sh(base + "--preset filament --out " + (s / "fil") + " >/dev/null") == 0);
+    REQUIRE(sh(base + "--preset gltf --out " + (s / "gltf") + " >/dev/null") == 0);
+    REQUIRE(sh(base + "--dfg-layout uniform --specular-lookup textbook --extract-sun off --irradiance-size 0 --out " + (s / "ref") +
+               " >/dev/null") == 0);
+    const auto fil = ibl_examples::parse_json(slurp(s / "fil/report.json"));
+    const auto ref = ibl_examples::parse_json(slurp(s / "ref/report.json"));
+    // mirror: the brightest direction's x flips, y and z stay
+    const auto& bf = fil.find("source")->find("brightest_direction")->values;
+    const auto& br = ref.find("source")->find("brightest_direction")->values;
+    CHECK(bf[0].number == doctest::Approx(-br[0].number));
+    CHECK(bf[1].number == doctest::Approx(br[1].number));
+    // the chain's levels follow lod = (V - 1) r (2 - r): r_l = 1 - sqrt(1 - l / (V - 1))
+    const auto& lv = fil.find("specular")->find("levels")->values;
+    REQUIRE(lv.size() == 4);
+    for (std::size_t l = 0; l < lv.size(); ++l)
+        CHECK(lv[l].find("roughness")->number == doctest::Approx(1.0 - std::sqrt(1.0 - double(l) / 3.0)));
+    CHECK(fil.find("plan")->find("runtime")->find("policy")->string == "filament");
+    // the DFG table: filament stores (B, A + B); gltf and the reference (A, B) at texel centres
+    const image_rgb32f tf = read_image(s / "fil/dfg.exr"), tr = read_image(s / "ref/dfg.exr"), tg = read_image(s / "gltf/dfg.exr");
+    REQUIRE(tf.rgb.size() == tr.rgb.size());
+    for (int j = 0; j < 32; ++j)
+        for (int i = 0; i < 32; ++i) {
+            const float a = tr.texel(i, j)[0], b = tr.texel(i, j)[1];
+            CHECK(tf.texel(i, j)[0] == b);
+            CHECK(tf.texel(i, j)[1] == a + b);
+            CHECK(tg.texel(i, j)[0] == a);
+            CHECK(tg.texel(i, j)[1] == b);
+        }
+    // --lookup undoes the channel layout: the same (A, B) from both folders
+    std::ofstream(s / "q.txt") << "dfg 0.3 0.4\ndfg 0.02 0.9\n";
+    REQUIRE(sh(tool + " --lookup " + (s / "fil") + " < " + (s / "q.txt") + " > " + (s / "af.txt")) == 0);
+    REQUIRE(sh(tool + " --lookup " + (s / "ref") + " < " + (s / "q.txt") + " > " + (s / "ar.txt")) == 0);
+    CHECK(slurp(s / "af.txt") == slurp(s / "ar.txt"));
+    // the KTX2 records the loader's facts
+    const std::string k = slurp(s / "fil/specular.ktx2");
+    const ktx2_info info = parse_ktx2(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(k.data()), k.size()));
+    std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
+    CHECK(kv["ibl.preset"] == "filament");
+    CHECK(kv["ibl.first_level"] == "0");
+    CHECK(kv["ibl.virtual_levels"] == "4");
+    CHECK(kv["ibl.policy"].rfind("filament", 0) == 0);
+    CHECK(kv["ibl.level_roughness"].find(' ') != std::string::npos);
+    CHECK(kv.count("KTXwriter") == 1);
+    // gltf: linear chain, no mirror
+    const auto gl = ibl_examples::parse_json(slurp(s / "gltf/report.json"));
+    CHECK(gl.find("source")->find("brightest_direction")->values[0].number == doctest::Approx(br[0].number));
+    CHECK(gl.find("specular")->find("levels")->values[1].find("roughness")->number == doctest::Approx(1.0 / 3.0));
+}
