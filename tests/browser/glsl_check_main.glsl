@@ -31,5 +31,9 @@ void main() {
     vec3 sp = ibl_specular_ibl_multiscatter(ms, ld, e);
     vec3 d = ibl_shade_directional(u_n, u_v, u_l, vec3(1.0), m) + ibl_shade_point(vec3(0.0), u_n, u_v, u_l, vec3(1.0), m);
     vec3 br = ibl_specular_brdf_direct(0.5, ibl_make_light_cosines(u_n, u_v, u_l), m.f0, m.f90, u_r);
-    o_color = vec4(b + ld + a + sp + d + br + t.lod, 1.0);
+    ibl_disk_light sun = ibl_disk_light(u_l, 6.8e-5, vec3(1.0e4));
+    vec3 dk = ibl_shade_disk(u_n, u_v, sun, m) + ibl_disk_light_irradiance(u_n, sun) +
+              ibl_disk_light_specular(u_n, u_v, sun, m.f0, m.f90, u_r) + ibl_disk_light_normal_irradiance(sun);
+    float cap = ibl_cap_irradiance(dot(u_n, u_l), ibl_cap_sin2(0.5)) + ibl_cap_one_minus_cos(0.5) + ibl_atan_minus_identity(u_r);
+    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap, 1.0);
 }

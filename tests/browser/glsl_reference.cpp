@@ -99,11 +99,58 @@ v4 row_value(int j, int i) {
         return {c.n_dot_l, c.n_dot_h, c.v_dot_h, ibl::v_smith_schlick_ggx(v.y, c.n_dot_l, ibl::k_direct(x))};
     }
     if (j == 11) return {ibl::ndf_ggx(1.0f - 0.5f * x, x * x), ibl::ndf_ggx(0.875f, x * x), ibl::k_direct(x), 0.0f};
+    if (j == 13) {
+        const float ct = 2.0f * x - 1.0f;
+        return {ibl::cap_irradiance(ct, ibl::cap_sin2(0.01f)), ibl::cap_irradiance(ct, ibl::cap_sin2(0.25f)),
+                ibl::cap_irradiance(ct, ibl::cap_sin2(1.0f)), ibl::cap_irradiance(ct, 1.0f)};
+    }
+    if (j == 14) {
+        const ibl::disk_light<float> dl{l, 0.25f, v3(1.0f, 2.0f, 3.0f)};
+        return {ibl::disk_light_specular(n, v, dl, m.f0, m.f90, x), ibl::disk_light_irradiance(n, dl).x};
+    }
+    if (j == 15) {
+        const ibl::disk_light<float> sun{l, 6.8e-5f, v3(1.0e4f, 2.0e4f, 3.0e4f)};
+        ibl::pbr_material<float> mat2 = mat;
+        mat2.roughness = 0.25f + 0.75f * x;
+        return {ibl::shade_disk(n, v, sun, ibl::resolve_material(mat2)), 0.0f};
+    }
     if (j == 12)
         return {ibl::roughness_from_lod(ibl::roughness_mapping::filament, x * 4.0f, 4.0f),
                 ibl::lod_from_roughness(ibl::roughness_mapping::filament, x, 4.0f),
                 ibl::dfg_axis_coord(ibl::dfg_axis::cbrt, x), ibl::dfg_axis_coord(ibl::dfg_axis::sqrt, x)};
     return v4(0.0f);
+}
+
+/// The disk-light rows' extra relative bound: D(n.h; alpha') amplifies an error dc of n.h by
+/// |d ln D / d c| = 4 c (1 - a^2) / (1 - c^2 (1 - a^2)) <= 4 / a^2 (a = alpha', at c = 1), and
+/// n.h comes from vectors each normalised in float on both sides (v, l: dir_of; h: make_light_cosines),
+/// so |dc| <= delta = 2^-21 (8 ulp of 1). a^2 >= alpha(r_min)^2 + tan^2(r/2) (v.h <= 1).
+double disk_rel(double omega, double r_min) {
+    const double c1 = omega / (2.0 * ibl::pi_v<double>), tan2_half = c1 / (2.0 - c1);
+    const double a2 = r_min * r_min * r_min * r_min + tan2_half;
+    return 4.0 * std::ldexp(1.0, -21) / a2;
+}
+
+/// Row 13's per-value absolute bound. acos and atan have no precision in GLSL ES 3.00 (Vulkan
+/// allows 4096 ulp); assumed here: absolute error <= trig_eps = 2^-14 (SwiftShader measured
+/// ~1.7e-5 on acos). Inside the straddling band E = s2 (ct acos y + u) + (atan u - u): acos
+/// enters times s2 |ct|, atan (used for u >= 1/4) times 1, and E is a difference of terms of
+/// that size (at the band's lower edge E -> 0 from terms ~s2 sin r), so no relative bound holds
+/// there. Outside the band (the whole cap above or below) no trig is used: 1e-6.
+double cap_abs_bound(int i, int col) {
+    constexpr double trig_eps = 1.0 / 16384.0;
+    const double omegas[3] = {0.01, 0.25, 1.0};
+    const double ct = 2.0 * double(u64(i)) - 1.0;
+    double s2 = 1.0;
+    if (col < 3) {
+        const double c1 = omegas[col] / (2.0 * ibl::pi_v<double>);
+        s2 = c1 * (2.0 - c1);
+    }
+    if (ct * ct >= s2) return 1e-6;
+    const double st = std::sqrt((1.0 - ct) * (1.0 + ct)), x = std::sqrt((1.0 - s2) / s2);
+    const double y = std::fmin(1.0, std::fmax(-1.0, -x * ct / st));
+    const double u = x > 0.0 ? st * std::sqrt((1.0 - y) * (1.0 + y)) / x : 0.0;
+    return 1e-6 + trig_eps * (s2 * std::fabs(ct) + (x > 0.0 && u >= 0.2 ? 1.0 : 0.0)); // 0.2: margin below 1/4
 }
 
 struct row_info {
@@ -127,6 +174,9 @@ int main() {
         {"ambient (single) + F_r", 1e-5, 1e-6},    {"shade_directional", 1e-5, 1e-6},
         {"light cosines + V", 1e-5, 1e-6},         {"ndf_ggx + k_direct", 1e-5, 1e-6},
         {"mapping + dfg axes", 1e-5, 1e-6},
+        {"cap_irradiance", 1e-5, 1e-6},
+        {"disk_light_specular (0.25 sr)", 1e-5 + disk_rel(0.25, 0.0), 1e-6},
+        {"shade_disk (sun, r >= 0.25)", 1e-5 + disk_rel(6.8e-5, 0.25), 1e-6},
     };
     std::printf("{\"width\": %d, \"height\": 16, \"rows\": [", width);
     const int n_rows = int(sizeof(rows) / sizeof(rows[0]));
@@ -137,7 +187,15 @@ int main() {
             const v4 v = row_value(j, i);
             std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", double(v.x), double(v.y), double(v.z), double(v.w));
         }
-        std::printf("]}");
+        std::printf("]");
+        if (j == 13) { // per-value absolute bounds (cap_abs_bound)
+            std::printf(", \"abs_values\": [");
+            for (int i = 0; i < width; ++i)
+                std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", cap_abs_bound(i, 0), cap_abs_bound(i, 1),
+                            cap_abs_bound(i, 2), cap_abs_bound(i, 3));
+            std::printf("]");
+        }
+        std::printf("}");
     }
     std::printf("]}\n");
     return 0;

@@ -1,6 +1,7 @@
 // tools/ibl-bake/stage_preview.cpp — check: preview.png, a 5 x 2 sphere grid (roughness 0, 0.25,
 // 0.5, 0.75, 1 left to right; dielectric top, metal bottom) shaded with the multiple-scattering
-// ambient (Fdez-Aguera 2019) from the baked products only, over a pinhole view of the source;
+// ambient (Fdez-Aguera 2019) from the baked products only (plus an extracted sun as a disk
+// light), over a pinhole view of the residual source with the sun's disk drawn analytically;
 // orthographic spheres, camera looking away from the brightest direction (spheres lit from the
 // front); exposure 0.6 / mean luminance, Reinhard, sRGB.
 
@@ -62,7 +63,13 @@ public:
         const double tan_h = std::tan(0.5 * hfov_deg * ibl::pi_v<double> / 180.0), tan_v = tan_h * double(h) / double(w);
         const double ndc_x = 2.0 * fx / w - 1.0, ndc_y = 1.0 - 2.0 * fy / h;
         const dvec3 d = glm::normalize(cam_.fwd + ndc_x * tan_h * cam_.right + ndc_y * tan_v * cam_.up);
-        return dvec3(source_.radiance(fvec3(d), 0.0f)); // the whole source (with its sun)
+        // The residual's level 0 (the chain's level 0, what a runtime has) plus the extracted sun's
+        // disk drawn analytically: its radiance where d is inside the cap, d.dir >= cos r,
+        // 1 - cos r = omega / (2 pi). Without extraction the residual is the whole source.
+        dvec3 l = dvec3(source_.radiance(fvec3(d), 0.0f));
+        if (bp_.sun && glm::dot(d, bp_.sun->direction) >= 1.0 - ibl::cap_one_minus_cos(bp_.sun->solid_angle))
+            l += bp_.sun->radiance;
+        return l;
     }
 
     static constexpr int w = cols * cell, h = rows_ * cell;
@@ -84,7 +91,7 @@ public:
         ss_ = ctx.qs.preview_ss;
         ctx.prog.begin("preview");
         const product_view bp = baked_view(ctx);
-        const preview_renderer pr(bp, ctx.whole_source(), ctx.light);
+        const preview_renderer pr(bp, ctx.source, ctx.light);
         img_ = image_rgb32f(pr.w, pr.h);
         ctx.ex(std::size_t(pr.h), [&](std::size_t b, std::size_t e) {
             for (std::size_t py = b; py < e; ++py)

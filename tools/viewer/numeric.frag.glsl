@@ -63,6 +63,20 @@ vec4 row_value(int j, int i) {
         return vec4(c.n_dot_l, c.n_dot_h, c.v_dot_h, ibl_v_smith_schlick_ggx(v.y, c.n_dot_l, ibl_k_direct(x)));
     }
     if (j == 11) return vec4(ibl_ndf_ggx(1.0 - 0.5 * x, x * x), ibl_ndf_ggx(0.875, x * x), ibl_k_direct(x), 0.0);
+    if (j == 13) { // cap irradiance E / L at cos theta in [-1, 1]: three caps and the hemisphere (r = pi/2)
+        float ct = 2.0 * x - 1.0;
+        return vec4(ibl_cap_irradiance(ct, ibl_cap_sin2(0.01)), ibl_cap_irradiance(ct, ibl_cap_sin2(0.25)),
+                    ibl_cap_irradiance(ct, ibl_cap_sin2(1.0)), ibl_cap_irradiance(ct, 1.0));
+    }
+    if (j == 14) { // disk light specular (omega 0.25 sr), roughness x, and its irradiance
+        ibl_disk_light dl = ibl_disk_light(l, 0.25, vec3(1.0, 2.0, 3.0));
+        return vec4(ibl_disk_light_specular(n, v, dl, m.f0, m.f90, x), ibl_disk_light_irradiance(n, dl).x);
+    }
+    if (j == 15) { // shade_disk of a sun-sized disk (6.8e-5 sr), roughness 0.25 + 0.75 x
+        ibl_disk_light sun = ibl_disk_light(l, 6.8e-5, vec3(1.0e4, 2.0e4, 3.0e4));
+        ibl_material_terms ms = ibl_resolve_material(ibl_make_material(vec3(0.75, 0.5, 0.25), float(i % 2), 0.25 + 0.75 * x));
+        return vec4(ibl_shade_disk(n, v, sun, ms), 0.0);
+    }
     if (j == 12) return vec4(ibl_roughness_from_lod(IBL_MAPPING_FILAMENT, x * 4.0, 4.0), ibl_lod_from_roughness(IBL_MAPPING_FILAMENT, x, 4.0),
                              ibl_dfg_axis_coord(IBL_DFG_AXIS_CBRT, x), ibl_dfg_axis_coord(IBL_DFG_AXIS_SQRT, x));
     return vec4(0.0);

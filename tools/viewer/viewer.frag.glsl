@@ -3,10 +3,11 @@
 //   u_mode 0  ibl-bake's preview.png, mirrored exactly (tools/ibl-bake/stage_preview.cpp): a 5 x 2
 //             grid of 128-pixel cells, orthographic spheres of radius 0.45 cell, roughness 0.25 i
 //             (column i), dielectric base 0.8 on top, metal (0.95, 0.64, 0.54) below,
-//             multiple-scattering ambient; background = level 0 through a 90-degree pinhole;
+//             multiple-scattering ambient plus the bake's sun (lights.json) as a disk light;
+//             background = level 0 (the residual) plus the sun's disk, through a 90-degree pinhole;
 //             u_ss x u_ss sub-pixel samples averaged in linear radiance; exposure, Reinhard, sRGB.
 //   u_mode 1  the interactive view: two spheres (dielectric, metal) of one roughness seen through
-//             a perspective camera over the environment, optional directional light.
+//             a perspective camera over the environment (with the sun), optional directional light.
 
 uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
@@ -28,6 +29,10 @@ uniform vec3 u_eye;
 uniform vec3 u_sphere_offset; // the spheres sit at -offset (dielectric) and +offset (metal)
 uniform vec3 u_light_dir;
 uniform vec3 u_light_irradiance; // 0: no direct light
+uniform int u_sun_on;            // 1: the bake extracted a sun (lights.json), added back as a disk light
+uniform vec3 u_sun_dir;          // unit, towards the sun
+uniform float u_sun_solid_angle; // sr
+uniform vec3 u_sun_radiance;
 
 out vec4 o_color;
 
@@ -48,6 +53,7 @@ vec3 shade_sphere(vec3 n, vec3 v, ibl_material mat) {
     ibl_material_terms m = ibl_resolve_material(mat);
     ibl_sample s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     vec3 c = ibl_ambient(m, clamp(dot(n, v), 0.0, 1.0), s, u_spec_rule.z != 0);
+    if (u_sun_on != 0) c += ibl_shade_disk(n, v, ibl_disk_light(u_sun_dir, u_sun_solid_angle, u_sun_radiance), m);
     if (dot(u_light_irradiance, u_light_irradiance) > 0.0)
         c += ibl_shade_directional(n, v, u_light_dir, u_light_irradiance, m);
     return c;
@@ -60,8 +66,14 @@ ibl_material sphere_material(int k, float roughness) {
     return ibl_make_material(vec3(0.95, 0.64, 0.54), 1.0, roughness);
 }
 
-// The environment seen along unit d: level 0 of the chain (the source when first_level is 0).
-vec3 background(vec3 d) { return textureLod(u_chain, d, 0.0).rgb; }
+// The environment seen along unit d: level 0 of the chain (the residual source when first_level
+// is 0) plus the sun's disk drawn analytically: its radiance where d is inside the cap,
+// d.dir >= cos r with 1 - cos r = omega / (2 pi) (stage_preview.cpp does the same).
+vec3 background(vec3 d) {
+    vec3 c = textureLod(u_chain, d, 0.0).rgb;
+    if (u_sun_on != 0 && dot(d, u_sun_dir) >= 1.0 - ibl_cap_one_minus_cos(u_sun_solid_angle)) c += u_sun_radiance;
+    return c;
+}
 
 // stage_preview.cpp's preview_renderer::at at image position (fx, fy) (y down, pixels).
 vec3 preview_at(float fx, float fy) {

@@ -12,7 +12,10 @@
 //
 // Files read from the folder: specular.ktx2 (required), dfg.hpp (required: the exact float table
 // in the layout of report.json), report.json (plan.runtime: the lookup conventions; source: the
-// exposure and camera of the preview), sh.json ("irradiance_over_pi_shader", or its "_windowed" form) or irradiance.ktx2.
+// exposure and camera of the preview), sh.json ("irradiance_over_pi_shader", or its "_windowed" form) or
+// irradiance.ktx2 (texels hold E; used when plan.runtime.diffuse is "irradiance_map"), lights.json
+// (optional: an extracted sun, added back as a disk light; the chain and the diffuse product hold the
+// environment without it).
 
 import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
 
@@ -75,7 +78,19 @@ async function loadBake(src) {
     bake.dfg = parseDfgHeader(await src.text('dfg.hpp'));
     bake.chain = parseKtx2Cubemap(await src.bytes('specular.ktx2'), 'specular.ktx2');
     bake.irradiance = (await src.has('irradiance.ktx2')) ? parseKtx2Cubemap(await src.bytes('irradiance.ktx2'), 'irradiance.ktx2') : null;
+    bake.sun = (await src.has('lights.json')) ? sunOf(JSON.parse(await src.text('lights.json'))) : null;
     return bake;
+}
+
+/// The first "sun" of lights.json ({"lights": [{"type": "sun", "direction", "solid_angle", "radiance", ...}]}),
+/// or null. The disk light of shade.hpp: direction (unit, towards it), solid angle (sr), radiance.
+export function sunOf(lights) {
+    const list = (lights && Array.isArray(lights.lights)) ? lights.lights : [];
+    const s = list.find((l) => l && l.type === 'sun');
+    if (!s) return null;
+    const vec = (a) => Array.isArray(a) && a.length === 3 && a.every(Number.isFinite);
+    if (!vec(s.direction) || !vec(s.radiance) || !Number.isFinite(s.solid_angle)) throw new Error('lights.json: a sun needs direction, solid_angle, radiance');
+    return { direction: s.direction, solidAngle: s.solid_angle, radiance: s.radiance };
 }
 
 // ---- conventions from report.json ------------------------------------------------------------------
@@ -280,6 +295,11 @@ class Renderer {
         // The optional light: irradiance pi x the mean radiance (a light as bright as the whole sky).
         const e = view.light ? Math.PI / this.exposure * 0.6 : 0;
         gl.uniform3f(u('u_light_irradiance'), e, e, e);
+        const sun = this.bake.sun;
+        gl.uniform1i(u('u_sun_on'), sun ? 1 : 0);
+        gl.uniform3fv(u('u_sun_dir'), sun ? sun.direction : [0, 1, 0]);
+        gl.uniform1f(u('u_sun_solid_angle'), sun ? sun.solidAngle : 0);
+        gl.uniform3fv(u('u_sun_radiance'), sun ? sun.radiance : [0, 0, 0]);
         gl.drawArrays(gl.TRIANGLES, 0, 3);
     }
 
@@ -302,6 +322,8 @@ class Renderer {
             version: gl.getParameter(gl.VERSION),
             chain_format: this.bake.chain.format.name,
             chain_levels: this.bake.chain.levels.map((l) => l.size),
+            irradiance_format: this.bake.irradiance ? this.bake.irradiance.format.name : null,
+            sun: this.bake.sun,
             lut_texture: this.lutFormat,
             lut_size: this.bake.dfg.size,
             exposure: this.exposure,
@@ -423,7 +445,8 @@ async function runViewer() {
             ready = true;
             const i = renderer.info();
             log(`${bake.label}: chain ${i.chain_levels.join('/')} ${i.chain_format}, LUT ${i.lut_size}^2 (${i.lut_texture}), ` +
-                `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, diffuse ${renderer.rt.diffuse}\n${i.renderer}`);
+                `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, diffuse ${renderer.rt.diffuse}, ` +
+                `sun ${bake.sun ? bake.sun.solidAngle.toPrecision(3) + ' sr' : 'none'}\n${i.renderer}`);
             redraw();
         } catch (e) {
             log(String(e.message || e));

@@ -1,9 +1,10 @@
 // ibl/glsl/ibl_shade.glsl — the runtime combination of the products (GLSL mirror of
 // ibl/shade.hpp): material terms (metallic workflow), the single-scattering ambient (Karis 2013,
 // kD = (1 - F_roughness)(1 - metallic)), the multiple-scattering ambient (Fdez-Aguera 2019:
-// FssEss LD + (FmsEms + diffuse_albedo Edss) E/pi), and direct Cook-Torrance lights
-// (directional, point). The formulas and their derivations are in shade.hpp's header; every
-// function here is the same expression in the same order. Needs ibl_common.glsl first;
+// FssEss LD + (FmsEms + diffuse_albedo Edss) E/pi), direct Cook-Torrance lights (directional,
+// point) and disk lights (a sun: exact cap irradiance, widened-lobe specular). The formulas and
+// their derivations are in shade.hpp's header; every function here is the same expression in the
+// same order. Needs ibl_common.glsl first;
 // ibl_lookup_sample additionally needs ibl_lookup.glsl before this file.
 
 #ifndef IBL_GLSL_SHADE
@@ -236,6 +237,86 @@ vec3 ibl_shade_point(vec3 p, vec3 n, vec3 v, vec3 position, vec3 intensity, ibl_
     float d2 = dot(to_light, to_light);
     vec3 l = d2 > 0.0 ? to_light * (1.0 / sqrt(d2)) : vec3(0.0);
     return ibl_shade_light(n, v, l, intensity * (1.0 / max(d2, 1e-4)), m);
+}
+
+// ---- disk lights (a sun: a uniform spherical cap; shade.hpp's "Disk lights" section) ---------------
+
+// A distant uniform disk: unit direction TOWARDS its centre, solid angle Omega = 2 pi (1 - cos r)
+// in [0, 2 pi] sr, radiance L (lights.json of ibl-bake: "direction", "solid_angle", "radiance").
+struct ibl_disk_light {
+    vec3 direction;
+    float solid_angle;
+    vec3 radiance;
+};
+
+// 1 - cos r of a cap of solid angle omega (clamped to [0, 1]: at most a hemisphere).
+float ibl_cap_one_minus_cos(float omega) { return ibl_saturate(omega * (0.5 * IBL_INV_PI)); }
+
+// sin^2 r = c (2 - c), c = 1 - cos r (no cancellation for small r).
+float ibl_cap_sin2(float omega) {
+    float c = ibl_cap_one_minus_cos(omega);
+    return c * (2.0 - c);
+}
+
+// atan(u) - u for u >= 0 without cancellation for small u (series below 1/4, 13 terms).
+float ibl_atan_minus_identity(float u) {
+    if (u >= 0.25) return atan(u) - u;
+    float u2 = u * u;
+    float s = 0.0;
+    for (int k = 12; k >= 0; --k) s = 1.0 / float(2 * k + 3) - u2 * s;
+    return -u * u2 * s;
+}
+
+// E / L of a uniform cap of unit radiance at cos(theta) = n.d from its centre, sin^2 r = sin2_r
+// (Snyder 1996 in Frostbite's form, rewritten without cancellation; exact, also when the cap
+// straddles the horizon). 0 for sin2_r <= 0.
+float ibl_cap_irradiance(float cos_theta, float sin2_r) {
+    if (!(sin2_r > 0.0)) return 0.0;
+    float ct = clamp(cos_theta, -1.0, 1.0);
+    if (ct * ct >= sin2_r) return IBL_PI * sin2_r * (ct > 0.0 ? ct : 0.0);
+    float s2 = sin2_r < 1.0 ? sin2_r : 1.0;
+    float st = sqrt((1.0 - ct) * (1.0 + ct)); // >= cos r > 0 in this band (or r = pi/2)
+    float x = sqrt((1.0 - s2) / s2);          // cot r
+    float y = clamp(-x * ct / (st > IBL_MIN_NORMAL ? st : IBL_MIN_NORMAL), -1.0, 1.0);
+    float t = st * sqrt((1.0 - y) * (1.0 + y));
+    float u = x > 0.0 ? t / x : 0.0;
+    // r = pi/2 (x = 0): the limit s2 ct acos(y) + pi/2.
+    float e = x > 0.0 ? s2 * (ct * acos(y) + u) + ibl_atan_minus_identity(u) : s2 * ct * acos(y) + 0.5 * IBL_PI;
+    return e > 0.0 ? e : 0.0;
+}
+
+// E(n) of a disk light at unit normal n (exact for a uniform cap).
+vec3 ibl_disk_light_irradiance(vec3 n, ibl_disk_light light) {
+    return light.radiance * ibl_cap_irradiance(dot(n, light.direction), ibl_cap_sin2(light.solid_angle));
+}
+
+// The irradiance it delivers on a surface facing it: L pi sin^2 r.
+vec3 ibl_disk_light_normal_irradiance(ibl_disk_light light) {
+    return light.radiance * (IBL_PI * ibl_cap_sin2(light.solid_angle));
+}
+
+// Cook-Torrance specular of a disk light by the widened lobe: D(n.h; alpha') V F(v.h) E_perp n.d at
+// the cap centre d, alpha'^2 = alpha^2 + tan^2(r/2) / max(v.h, 1/20) (alpha' <= 1).
+vec3 ibl_disk_light_specular(vec3 n, vec3 v, ibl_disk_light light, vec3 f0, vec3 f90, float roughness) {
+    float r = ibl_saturate(roughness);
+    ibl_light_cosines c = ibl_make_light_cosines(n, v, light.direction);
+    float c1 = ibl_cap_one_minus_cos(light.solid_angle);
+    float tan2_half = c1 / (2.0 - c1); // tan^2(r/2)
+    float vh = c.v_dot_h > 0.05 ? c.v_dot_h : 0.05;
+    float a = clamp(r * r, IBL_GGX_MIN_ALPHA, 1.0);
+    float alpha_w = sqrt(a * a + tan2_half / vh);
+    float d = ibl_ndf_ggx(c.n_dot_h, alpha_w < 1.0 ? alpha_w : 1.0);
+    float vis = ibl_v_smith_schlick_ggx(ibl_saturate(dot(n, v)), c.n_dot_l, ibl_k_direct(r));
+    return (d * vis * c.n_dot_l) * ibl_fresnel_schlick(c.v_dot_h, f0, f90) * ibl_disk_light_normal_irradiance(light);
+}
+
+// Outgoing radiance from a disk light: the exact cap irradiance times kD base_color / pi
+// (kD = (1 - F(v.h))(1 - metallic), h towards the cap centre) plus ibl_disk_light_specular.
+vec3 ibl_shade_disk(vec3 n, vec3 v, ibl_disk_light light, ibl_material_terms m) {
+    ibl_light_cosines c = ibl_make_light_cosines(n, v, light.direction);
+    vec3 kd = ibl_ambient_kd(ibl_fresnel_schlick(c.v_dot_h, m.f0, m.f90), m.metallic);
+    return kd * (m.base_color * IBL_INV_PI) * ibl_disk_light_irradiance(n, light) +
+           ibl_disk_light_specular(n, v, light, m.f0, m.f90, m.roughness);
 }
 
 #endif // IBL_GLSL_SHADE
