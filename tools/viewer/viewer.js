@@ -186,12 +186,19 @@ function uploadCube(gl, cube) {
 }
 
 /// The DFG table as RGBA32F (exact floats) when float filtering exists, else RGBA16F.
-function uploadLut(gl, dfg) {
+function uploadLut(gl, dfg, channelsLayout) {
     const n = dfg.size, c = dfg.channels;
     const rgba = new Float32Array(4 * n * n);
     for (let i = 0; i < n * n; ++i) {
         for (let k = 0; k < 4; ++k) rgba[4 * i + k] = k < c ? dfg.values[c * i + k] : (k === 3 ? 1 : 0);
     }
+    // --preset filament stores (B, A + B, k) for mix(dfg.x, dfg.y, f0): back to the shader's (A, B).
+    if (channelsLayout && channelsLayout.startsWith('B,'))
+        for (let i = 0; i < n * n; ++i) {
+            const b = rgba[4 * i], e = rgba[4 * i + 1];
+            rgba[4 * i] = Math.fround(e - b);
+            rgba[4 * i + 1] = b;
+        }
     const floatLinear = !!gl.getExtension('OES_texture_float_linear');
     const tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
@@ -220,7 +227,8 @@ class Renderer {
         this.bake = bake;
         this.rt = runtimeOf(bake);
         this.chainTex = uploadCube(gl, bake.chain);
-        const lut = uploadLut(gl, bake.dfg);
+        const rtj = bake.report && bake.report.plan && bake.report.plan.runtime;
+        const lut = uploadLut(gl, bake.dfg, rtj && rtj.dfg_channels_layout);
         this.lutTex = lut.tex;
         this.lutFormat = lut.format;
         this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance) : this.chainTex;
