@@ -377,6 +377,188 @@ std::string exr_part_label(const exr_part_scan& P, std::size_t index) {
     return "part " + std::to_string(index) + (P.has_name ? " '" + printable(P.name, 64) + "'" : std::string());
 }
 
+/// The value checks of the attribute types OpenEXR allocates from (preview, string vectors,
+/// float vectors, channel lists); a channel list adds to P's bytes per pixel.
+void check_exr_attribute_value(const exr_reader& r, exr_reader& vr, std::span<const unsigned char> v, std::string_view attr,
+                               std::string_view type, std::int32_t size, std::size_t max_name, const std::string& what,
+                               exr_part_scan& P) {
+    if (type == "preview") { // width, height, 4 w h bytes: OpenEXR allocates from the two fields
+        if (size < 8) r.fail(what + " too short");
+        const std::uint64_t pw = vr.u32(what), ph = vr.u32(what);
+        if (8 + 4 * pw * ph != std::uint64_t(size) || pw > 65536 || ph > 65536)
+            r.fail(what + " declares a " + std::to_string(pw) + " x " + std::to_string(ph) + " preview in " +
+                   std::to_string(size) + " bytes");
+    } else if (type == "stringvector") { // (int32 length, characters)*, exactly `size` bytes
+        while (vr.p < v.size()) {
+            const std::int32_t n = vr.i32(what);
+            if (n < 0 || std::size_t(n) > v.size() - vr.p) r.fail(what + " has an entry beyond its size");
+            vr.p += std::size_t(n);
+        }
+    } else if (type == "floatvector") {
+        if (size % 4 != 0) r.fail(what + " has a size that is not a multiple of 4");
+    } else if (type == "chlist") { // (name, int32 type, u8 linear, 3 reserved, int32 xs, int32 ys)*, ""
+        std::size_t count = 0;
+        for (;;) {
+            const std::string_view ch = vr.name(max_name, what);
+            if (ch.empty()) break;
+            const std::int32_t pt = vr.i32(what);
+            vr.need(4, what);
+            vr.p += 4;
+            (void)vr.i32(what);
+            (void)vr.i32(what);
+            if (pt < 0 || pt > 2) r.fail("channel '" + printable(ch) + "' has pixel type " + std::to_string(pt));
+            P.bytes_per_pixel += pt == 1 ? 2 : 4; // HALF : UINT, FLOAT
+            ++count;
+        }
+        if (vr.p != v.size()) r.fail(what + " does not end where its size says");
+        if (attr == "channels") {
+            if (count == 0) r.fail("no channels");
+            P.has_channels = true;
+        }
+    }
+}
+
+/// The attributes the reader needs, stored in P.
+void store_exr_attribute(const exr_reader& r, exr_reader& vr, std::span<const unsigned char> v, std::string_view attr,
+                         std::string_view type, const std::string& what, const std::string& file, exr_part_scan& P) {
+    const auto typed = [&](std::string_view want) {
+        if (type != want) r.fail(what + " has type '" + printable(type) + "', not " + std::string(want));
+    };
+    const auto box = [&] {
+        exr_box x;
+        x.x0 = vr.i32(what);
+        x.y0 = vr.i32(what);
+        x.x1 = vr.i32(what);
+        x.y1 = vr.i32(what);
+        return x;
+    };
+    if (attr == "dataWindow") {
+        typed("box2i");
+        P.data = box();
+        P.has_data = true;
+    } else if (attr == "displayWindow") {
+        typed("box2i");
+        P.display = box();
+        P.has_display = true;
+    } else if (attr == "compression") {
+        typed("compression");
+        P.compression = v[0];
+        if (P.compression >= int(std::size(exr_compression_names)))
+            throw image_error(file, "unsupported OpenEXR compression (value " + std::to_string(P.compression) + ")");
+    } else if (attr == "tiles") {
+        typed("tiledesc");
+        P.tile_x = vr.u32(what);
+        P.tile_y = vr.u32(what);
+        const std::uint8_t mode = vr.u8(what);
+        P.level_mode = mode & 0x0f;
+        P.rounding_mode = mode >> 4;
+        if (P.level_mode > 2 || P.rounding_mode > 1) r.fail("unknown tile level mode " + std::to_string(mode));
+        P.has_tiles = true;
+    } else if (attr == "chunkCount") {
+        typed("int");
+        P.chunk_count = vr.i32(what);
+        P.has_chunk_count = true;
+    } else if (attr == "name") {
+        typed("string");
+        P.name.assign(reinterpret_cast<const char*>(v.data()), v.size());
+        P.has_name = true;
+    } else if (attr == "type") {
+        typed("string");
+        P.type.assign(reinterpret_cast<const char*>(v.data()), v.size());
+        P.has_type = true;
+    } else if (attr == "channels") {
+        typed("chlist");
+    }
+}
+
+/// Reads one attribute of a part's header (its name already read) into P; throws for anything
+/// OpenEXR would misread.
+void scan_exr_attribute(exr_reader& r, std::span<const unsigned char> b, std::string_view attr, std::size_t max_name,
+                        exr_part_scan& P) {
+    const std::string& file = r.file;
+    const std::string what = "attribute '" + printable(attr) + "'";
+    const std::string_view type = r.name(max_name, "the type name of " + what);
+    const std::int32_t size = r.i32(what);
+    if (size < 0) r.fail(what + " has a negative size");
+    r.need(std::size_t(size), what);
+    const std::span<const unsigned char> v = b.subspan(r.p, std::size_t(size));
+    const int fixed = exr_fixed_attribute_size(type);
+    if (fixed >= 0 && size != fixed)
+        r.fail(what + " of type " + printable(type) + " has size " + std::to_string(size) + ", not " +
+               std::to_string(fixed));
+    exr_reader vr{v, 0, file};
+    check_exr_attribute_value(r, vr, v, attr, type, size, max_name, what, P);
+    store_exr_attribute(r, vr, v, attr, type, what, file, P);
+    r.p += std::size_t(size);
+}
+
+/// Checks a part's header as a whole (required attributes, type, windows, tiles, decoded size,
+/// chunk count); throws image_error.
+void check_exr_part(exr_part_scan& P, std::size_t index, bool multipart, std::uint32_t flags, const std::string& file,
+                    const read_options& o) {
+    const std::string label = exr_part_label(P, index);
+    const auto bad = [&](const std::string& what) -> image_error {
+        return image_error(file, "corrupt OpenEXR header (" + label + ": " + what + ")");
+    };
+    if (!P.has_channels) throw bad("no channels attribute");
+    if (P.compression < 0) throw bad("no compression attribute");
+    if (!P.has_data || !P.has_display) throw bad("no data or display window");
+    if (multipart) {
+        // Every part of a multi-part file names its type; the version's tiled flag is unused.
+        if (!P.has_type) throw bad("no type attribute");
+        if (!P.has_name) throw bad("no name attribute");
+        if (!P.has_chunk_count) throw bad("no chunkCount attribute");
+        if (P.type == "scanlineimage" || P.type == "tiledimage") {
+            P.tiled = P.type == "tiledimage";
+        } else if (P.type == "deepscanline" || P.type == "deeptile") {
+            P.tiled = P.type == "deeptile";
+            P.deep = true;
+        } else {
+            throw image_error(file, "unsupported OpenEXR part type '" + printable(P.type) + "' (" + label + ")");
+        }
+    } else {
+        // A single-part file's layout is its version's tiled flag; a `type` attribute must agree.
+        P.tiled = flags & exr_tiled_flag;
+        const char* expected = P.tiled ? "tiledimage" : "scanlineimage";
+        if (P.has_type && P.type != expected)
+            throw image_error(file, "OpenEXR type attribute '" + printable(P.type) + "' contradicts the file's " +
+                                        (P.tiled ? "tiled" : "scanline") + " layout (expected '" + expected + "')");
+    }
+    const auto dims = [](const exr_box& x, std::int64_t& w, std::int64_t& h) {
+        w = std::clamp<std::int64_t>(x.width(), -1, INT_MAX);
+        h = std::clamp<std::int64_t>(x.height(), -1, INT_MAX);
+    };
+    std::int64_t w = 0, h = 0, dw = 0, dh = 0;
+    dims(P.display, dw, dh);
+    check_dimensions(int(dw), int(dh), o, file, ("OpenEXR display window of " + label).c_str());
+    dims(P.data, w, h);
+    check_dimensions(int(w), int(h), o, file, ("OpenEXR data window of " + label).c_str());
+    if (P.tiled) {
+        if (!P.has_tiles) throw bad("tiled, but no tiles attribute");
+        if (P.tile_x < 1 || P.tile_y < 1 || P.tile_x > std::uint32_t(o.max_dimension) ||
+            P.tile_y > std::uint32_t(o.max_dimension))
+            throw bad("tile size " + std::to_string(P.tile_x) + " x " + std::to_string(P.tile_y) +
+                      " outside [1, " + std::to_string(o.max_dimension) + "]");
+    }
+    if (!P.deep) {
+        // OpenEXR allocates the decoded pixels of a chunk (a block of scanlines or a tile) up
+        // front, and the reader the whole data window: both must fit max_decoded_bytes.
+        const std::uint64_t chunk_pixels =
+            P.tiled ? std::uint64_t(P.tile_x) * P.tile_y : std::uint64_t(w) * std::uint64_t(exr_lines_per_chunk[P.compression]);
+        const std::uint64_t limit = o.max_decoded_bytes;
+        for (const std::uint64_t pixels : {std::uint64_t(w) * std::uint64_t(h), chunk_pixels})
+            if (P.bytes_per_pixel > limit || pixels > limit / P.bytes_per_pixel)
+                throw image_error(file, "OpenEXR " + label + ": " + std::to_string(pixels) + " pixels of " +
+                                            std::to_string(P.bytes_per_pixel) +
+                                            " bytes exceed the decoding limit of " + std::to_string(limit) + " bytes");
+    }
+    const std::uint64_t chunks = exr_chunk_count(P);
+    if (P.has_chunk_count && (P.chunk_count < 0 || std::uint64_t(P.chunk_count) != chunks))
+        throw bad("chunkCount " + std::to_string(P.chunk_count) + ", but the layout has " + std::to_string(chunks) +
+                  " chunks");
+    P.chunk_count = std::int64_t(chunks);
+}
+
 /// Walks the headers of every part; throws image_error for anything OpenEXR would misread, any
 /// size beyond the limits and any layout the reader does not support.
 std::vector<exr_part_scan> scan_exr_headers(std::span<const unsigned char> b, const std::string& file,
@@ -395,7 +577,6 @@ std::vector<exr_part_scan> scan_exr_headers(std::span<const unsigned char> b, co
     const bool multipart = flags & exr_multipart_flag;
     if (!multipart && (flags & exr_non_image_flag)) throw image_error(file, "deep OpenEXR images are not supported");
     const std::size_t max_name = (flags & exr_long_names_flag) ? 255 : 31;
-
     std::vector<exr_part_scan> parts;
     for (;;) {
         if (multipart && r.u8("the part list") == 0) break; // the empty header ending the list
@@ -403,165 +584,9 @@ std::vector<exr_part_scan> scan_exr_headers(std::span<const unsigned char> b, co
         if (parts.size() >= 4096) throw image_error(file, "corrupt OpenEXR header (more than 4096 parts)");
         exr_part_scan P;
         const std::string where = "the header of part " + std::to_string(parts.size());
-        for (;;) {
-            const std::string_view attr = r.name(max_name, where);
-            if (attr.empty()) break;
-            const std::string what = "attribute '" + printable(attr) + "'";
-            const std::string_view type = r.name(max_name, "the type name of " + what);
-            const std::int32_t size = r.i32(what);
-            if (size < 0) r.fail(what + " has a negative size");
-            r.need(std::size_t(size), what);
-            const std::span<const unsigned char> v = b.subspan(r.p, std::size_t(size));
-            const int fixed = exr_fixed_attribute_size(type);
-            if (fixed >= 0 && size != fixed)
-                r.fail(what + " of type " + printable(type) + " has size " + std::to_string(size) + ", not " +
-                       std::to_string(fixed));
-            exr_reader vr{v, 0, file};
-            const auto typed = [&](std::string_view want) {
-                if (type != want) r.fail(what + " has type '" + printable(type) + "', not " + std::string(want));
-            };
-            if (type == "preview") { // width, height, 4 w h bytes: OpenEXR allocates from the two fields
-                if (size < 8) r.fail(what + " too short");
-                const std::uint64_t pw = vr.u32(what), ph = vr.u32(what);
-                if (8 + 4 * pw * ph != std::uint64_t(size) || pw > 65536 || ph > 65536)
-                    r.fail(what + " declares a " + std::to_string(pw) + " x " + std::to_string(ph) + " preview in " +
-                           std::to_string(size) + " bytes");
-            } else if (type == "stringvector") { // (int32 length, characters)*, exactly `size` bytes
-                while (vr.p < v.size()) {
-                    const std::int32_t n = vr.i32(what);
-                    if (n < 0 || std::size_t(n) > v.size() - vr.p) r.fail(what + " has an entry beyond its size");
-                    vr.p += std::size_t(n);
-                }
-            } else if (type == "floatvector") {
-                if (size % 4 != 0) r.fail(what + " has a size that is not a multiple of 4");
-            } else if (type == "chlist") { // (name, int32 type, u8 linear, 3 reserved, int32 xs, int32 ys)*, ""
-                std::size_t count = 0;
-                for (;;) {
-                    const std::string_view ch = vr.name(max_name, what);
-                    if (ch.empty()) break;
-                    const std::int32_t pt = vr.i32(what);
-                    vr.need(4, what);
-                    vr.p += 4;
-                    (void)vr.i32(what);
-                    (void)vr.i32(what);
-                    if (pt < 0 || pt > 2) r.fail("channel '" + printable(ch) + "' has pixel type " + std::to_string(pt));
-                    P.bytes_per_pixel += pt == 1 ? 2 : 4; // HALF : UINT, FLOAT
-                    ++count;
-                }
-                if (vr.p != v.size()) r.fail(what + " does not end where its size says");
-                if (attr == "channels") {
-                    if (count == 0) r.fail("no channels");
-                    P.has_channels = true;
-                }
-            }
-            const auto box = [&] {
-                exr_box x;
-                x.x0 = vr.i32(what);
-                x.y0 = vr.i32(what);
-                x.x1 = vr.i32(what);
-                x.y1 = vr.i32(what);
-                return x;
-            };
-            if (attr == "dataWindow") {
-                typed("box2i");
-                P.data = box();
-                P.has_data = true;
-            } else if (attr == "displayWindow") {
-                typed("box2i");
-                P.display = box();
-                P.has_display = true;
-            } else if (attr == "compression") {
-                typed("compression");
-                P.compression = v[0];
-                if (P.compression >= int(std::size(exr_compression_names)))
-                    throw image_error(file, "unsupported OpenEXR compression (value " + std::to_string(P.compression) + ")");
-            } else if (attr == "tiles") {
-                typed("tiledesc");
-                P.tile_x = vr.u32(what);
-                P.tile_y = vr.u32(what);
-                const std::uint8_t mode = vr.u8(what);
-                P.level_mode = mode & 0x0f;
-                P.rounding_mode = mode >> 4;
-                if (P.level_mode > 2 || P.rounding_mode > 1) r.fail("unknown tile level mode " + std::to_string(mode));
-                P.has_tiles = true;
-            } else if (attr == "chunkCount") {
-                typed("int");
-                P.chunk_count = vr.i32(what);
-                P.has_chunk_count = true;
-            } else if (attr == "name") {
-                typed("string");
-                P.name.assign(reinterpret_cast<const char*>(v.data()), v.size());
-                P.has_name = true;
-            } else if (attr == "type") {
-                typed("string");
-                P.type.assign(reinterpret_cast<const char*>(v.data()), v.size());
-                P.has_type = true;
-            } else if (attr == "channels") {
-                typed("chlist");
-            }
-            r.p += std::size_t(size);
-        }
-        const std::string label = exr_part_label(P, parts.size());
-        const auto bad = [&](const std::string& what) -> image_error {
-            return image_error(file, "corrupt OpenEXR header (" + label + ": " + what + ")");
-        };
-        if (!P.has_channels) throw bad("no channels attribute");
-        if (P.compression < 0) throw bad("no compression attribute");
-        if (!P.has_data || !P.has_display) throw bad("no data or display window");
-        if (multipart) {
-            // Every part of a multi-part file names its type; the version's tiled flag is unused.
-            if (!P.has_type) throw bad("no type attribute");
-            if (!P.has_name) throw bad("no name attribute");
-            if (!P.has_chunk_count) throw bad("no chunkCount attribute");
-            if (P.type == "scanlineimage" || P.type == "tiledimage") {
-                P.tiled = P.type == "tiledimage";
-            } else if (P.type == "deepscanline" || P.type == "deeptile") {
-                P.tiled = P.type == "deeptile";
-                P.deep = true;
-            } else {
-                throw image_error(file, "unsupported OpenEXR part type '" + printable(P.type) + "' (" + label + ")");
-            }
-        } else {
-            // A single-part file's layout is its version's tiled flag; a `type` attribute must agree.
-            P.tiled = flags & exr_tiled_flag;
-            const char* expected = P.tiled ? "tiledimage" : "scanlineimage";
-            if (P.has_type && P.type != expected)
-                throw image_error(file, "OpenEXR type attribute '" + printable(P.type) + "' contradicts the file's " +
-                                            (P.tiled ? "tiled" : "scanline") + " layout (expected '" + expected + "')");
-        }
-        const auto dims = [](const exr_box& x, std::int64_t& w, std::int64_t& h) {
-            w = std::clamp<std::int64_t>(x.width(), -1, INT_MAX);
-            h = std::clamp<std::int64_t>(x.height(), -1, INT_MAX);
-        };
-        std::int64_t w = 0, h = 0, dw = 0, dh = 0;
-        dims(P.display, dw, dh);
-        check_dimensions(int(dw), int(dh), o, file, ("OpenEXR display window of " + label).c_str());
-        dims(P.data, w, h);
-        check_dimensions(int(w), int(h), o, file, ("OpenEXR data window of " + label).c_str());
-        if (P.tiled) {
-            if (!P.has_tiles) throw bad("tiled, but no tiles attribute");
-            if (P.tile_x < 1 || P.tile_y < 1 || P.tile_x > std::uint32_t(o.max_dimension) ||
-                P.tile_y > std::uint32_t(o.max_dimension))
-                throw bad("tile size " + std::to_string(P.tile_x) + " x " + std::to_string(P.tile_y) +
-                          " outside [1, " + std::to_string(o.max_dimension) + "]");
-        }
-        if (!P.deep) {
-            // OpenEXR allocates the decoded pixels of a chunk (a block of scanlines or a tile) up
-            // front, and the reader the whole data window: both must fit max_decoded_bytes.
-            const std::uint64_t chunk_pixels =
-                P.tiled ? std::uint64_t(P.tile_x) * P.tile_y : std::uint64_t(w) * std::uint64_t(exr_lines_per_chunk[P.compression]);
-            const std::uint64_t limit = o.max_decoded_bytes;
-            for (const std::uint64_t pixels : {std::uint64_t(w) * std::uint64_t(h), chunk_pixels})
-                if (P.bytes_per_pixel > limit || pixels > limit / P.bytes_per_pixel)
-                    throw image_error(file, "OpenEXR " + label + ": " + std::to_string(pixels) + " pixels of " +
-                                                std::to_string(P.bytes_per_pixel) +
-                                                " bytes exceed the decoding limit of " + std::to_string(limit) + " bytes");
-        }
-        const std::uint64_t chunks = exr_chunk_count(P);
-        if (P.has_chunk_count && (P.chunk_count < 0 || std::uint64_t(P.chunk_count) != chunks))
-            throw bad("chunkCount " + std::to_string(P.chunk_count) + ", but the layout has " + std::to_string(chunks) +
-                      " chunks");
-        P.chunk_count = std::int64_t(chunks);
+        for (std::string_view attr = r.name(max_name, where); !attr.empty(); attr = r.name(max_name, where))
+            scan_exr_attribute(r, b, attr, max_name, P);
+        check_exr_part(P, parts.size(), multipart, flags, file, o);
         parts.push_back(std::move(P));
         if (!multipart) break;
     }
@@ -721,136 +746,130 @@ image_rgb32f read_hdr_memory(std::span<const unsigned char> bytes, const std::st
 
 namespace {
 
-/// Reads the selected part's display window as RGB floats (see image_io.hpp for the rules).
-image_rgb32f decode_exr_part(std::span<const unsigned char> bytes, const std::string& name, const read_options& o,
-                             span_istream& in, std::string& detail) {
-    Imf::MultiPartInputFile file(in, exr_threads, true);
+std::string exr_part_names(Imf::MultiPartInputFile& file) {
+    std::string s;
+    for (int i = 0; i < file.parts(); ++i)
+        s += (i ? ", " : "") + (file.header(i).hasName() ? "'" + printable(file.header(i).name(), 64) + "'" : "#" + std::to_string(i));
+    return s;
+}
+
+std::string exr_channel_names(const Imf::ChannelList& channels) {
+    std::string found;
+    for (auto it = channels.begin(); it != channels.end(); ++it) found += (found.empty() ? "" : ", ") + printable(it.name(), 32);
+    return found;
+}
+
+bool exr_has(Imf::MultiPartInputFile& file, int i, const char* ch) { return file.header(i).channels().findChannel(ch) != nullptr; }
+
+bool exr_is_image(Imf::MultiPartInputFile& file, int i) {
+    const Imf::Header& h = file.header(i);
+    return !h.hasType() || h.type() == Imf::SCANLINEIMAGE || h.type() == Imf::TILEDIMAGE;
+}
+
+/// The part to read: the one named by o.part, else the first with R, G, B, else the first with Y.
+int choose_exr_part(Imf::MultiPartInputFile& file, const std::string& name, const read_options& o) {
     const int parts = file.parts();
-    const auto has = [&](int i, const char* ch) { return file.header(i).channels().findChannel(ch) != nullptr; };
-    const auto is_image = [&](int i) {
-        const Imf::Header& h = file.header(i);
-        return !h.hasType() || h.type() == Imf::SCANLINEIMAGE || h.type() == Imf::TILEDIMAGE;
-    };
-    const auto part_names = [&] {
-        std::string s;
-        for (int i = 0; i < parts; ++i)
-            s += (i ? ", " : "") + (file.header(i).hasName() ? "'" + printable(file.header(i).name(), 64) + "'"
-                                                              : "#" + std::to_string(i));
-        return s;
-    };
     int chosen = -1;
     if (!o.part.empty()) {
         for (int i = 0; i < parts && chosen < 0; ++i)
             if (file.header(i).hasName() && file.header(i).name() == o.part) chosen = i;
         if (chosen < 0)
-            throw image_error(name, "OpenEXR has no part named '" + printable(o.part, 64) + "' (parts: " + part_names() + ")");
-        if (!is_image(chosen))
+            throw image_error(name, "OpenEXR has no part named '" + printable(o.part, 64) + "' (parts: " + exr_part_names(file) + ")");
+        if (!exr_is_image(file, chosen))
             throw image_error(name, "OpenEXR part '" + printable(o.part, 64) + "' holds deep data (not supported)");
-    } else {
-        for (int i = 0; i < parts && chosen < 0; ++i)
-            if (is_image(i) && has(i, "R") && has(i, "G") && has(i, "B")) chosen = i;
-        for (int i = 0; i < parts && chosen < 0; ++i)
-            if (is_image(i) && has(i, "Y")) chosen = i;
-        if (chosen < 0) {
-            std::string found;
-            for (auto it = file.header(0).channels().begin(); it != file.header(0).channels().end(); ++it)
-                found += (found.empty() ? "" : ", ") + printable(it.name(), 32);
-            throw image_error(name, parts == 1 ? "OpenEXR has no R, G, B or Y channels (channels: " + found + ")"
-                                               : "OpenEXR has no part with R, G, B or Y channels (parts: " + part_names() + ")");
-        }
+        return chosen;
     }
-    const Imf::Header& H = file.header(chosen);
-    const Imf::ChannelList& channels = H.channels();
-    const bool rgb = has(chosen, "R") && has(chosen, "G") && has(chosen, "B");
-    const bool luma = !rgb && has(chosen, "Y");
-    const bool chroma = luma && has(chosen, "RY") && has(chosen, "BY");
-    if (!rgb && !luma) {
-        std::string found;
-        for (auto it = channels.begin(); it != channels.end(); ++it) found += (found.empty() ? "" : ", ") + printable(it.name(), 32);
+    for (int i = 0; i < parts && chosen < 0; ++i)
+        if (exr_is_image(file, i) && exr_has(file, i, "R") && exr_has(file, i, "G") && exr_has(file, i, "B")) chosen = i;
+    for (int i = 0; i < parts && chosen < 0; ++i)
+        if (exr_is_image(file, i) && exr_has(file, i, "Y")) chosen = i;
+    if (chosen < 0)
+        throw image_error(name, parts == 1 ? "OpenEXR has no R, G, B or Y channels (channels: " +
+                                                 exr_channel_names(file.header(0).channels()) + ")"
+                                           : "OpenEXR has no part with R, G, B or Y channels (parts: " + exr_part_names(file) + ")");
+    return chosen;
+}
+
+/// What the chosen part holds: RGB, Y alone, or Y/RY/BY (each channel at full resolution).
+struct exr_channels_kind {
+    bool rgb = false, luma = false, chroma = false;
+};
+exr_channels_kind exr_kind(Imf::MultiPartInputFile& file, int chosen, const std::string& name, const read_options& o) {
+    exr_channels_kind k;
+    const Imf::ChannelList& channels = file.header(chosen).channels();
+    k.rgb = exr_has(file, chosen, "R") && exr_has(file, chosen, "G") && exr_has(file, chosen, "B");
+    k.luma = !k.rgb && exr_has(file, chosen, "Y");
+    k.chroma = k.luma && exr_has(file, chosen, "RY") && exr_has(file, chosen, "BY");
+    if (!k.rgb && !k.luma)
         throw image_error(name, "OpenEXR part '" + printable(o.part, 64) + "' has no R, G, B or Y channels (channels: " +
-                                    found + ")");
-    }
-    const auto full_resolution = [&](const char* ch) {
+                                    exr_channel_names(channels) + ")");
+    static constexpr const char* rgb_names[3] = {"R", "G", "B"};
+    static constexpr const char* y_name[1] = {"Y"};
+    for (const char* ch : k.rgb ? std::span<const char* const>(rgb_names) : std::span<const char* const>(y_name)) {
         const Imf::Channel& c = *channels.findChannel(ch);
         if (c.xSampling != 1 || c.ySampling != 1)
             throw image_error(name, std::string("subsampled OpenEXR channel '") + ch + "' not supported");
-    };
-    if (rgb) {
-        full_resolution("R");
-        full_resolution("G");
-        full_resolution("B");
-    } else {
-        full_resolution("Y");
     }
-    const Imath::Box2i dwin = H.dataWindow(), disp = H.displayWindow();
-    const int dw = dwin.max.x - dwin.min.x + 1, dh = dwin.max.y - dwin.min.y + 1;
-    const int w = disp.max.x - disp.min.x + 1, h = disp.max.y - disp.min.y + 1;
-    check_dimensions(w, h, o, name, "OpenEXR display window"); // the scan checked these already
-    check_dimensions(dw, dh, o, name, "OpenEXR data window");
-    const bool tiled = H.hasType() ? Imf::isTiled(H.type()) : Imf::isTiled(file.version());
-    detail = (parts > 1 ? "part " + std::to_string(chosen) +
-                              (H.hasName() ? " '" + printable(H.name(), 64) + "'" : std::string()) + " of " +
-                              std::to_string(parts) + ", "
-                        : std::string()) +
-             exr_compression_names[std::min<int>(H.compression(), int(std::size(exr_compression_names)) - 1)] +
-             (tiled ? ", tiled" : ", scanline") + (rgb ? ", RGB" : chroma ? ", Y/RY/BY" : ", Y");
+    return k;
+}
 
-    // The data window's pixels, RGB interleaved.
-    const std::size_t dn = std::size_t(dw) * std::size_t(dh);
-    std::vector<float> px(3 * dn, 0.0f);
-    if (!chroma) {
-        Imf::InputPart part(file, chosen);
-        Imf::FrameBuffer fb;
-        if (rgb) {
-            for (int k = 0; k < 3; ++k)
-                fb.insert(k == 0 ? "R" : k == 1 ? "G" : "B",
-                          Imf::Slice::Make(Imf::FLOAT, px.data() + k, dwin, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(dw)));
+/// The data window's RGB (or Y, copied to all three) pixels of a part, RGB interleaved.
+void read_exr_rgb_or_y(Imf::MultiPartInputFile& file, int chosen, bool rgb, const Imath::Box2i& dwin, std::vector<float>& px) {
+    const int dw = dwin.max.x - dwin.min.x + 1;
+    Imf::InputPart part(file, chosen);
+    Imf::FrameBuffer fb;
+    for (int k = 0; k < (rgb ? 3 : 1); ++k)
+        fb.insert(rgb ? (k == 0 ? "R" : k == 1 ? "G" : "B") : "Y",
+                  Imf::Slice::Make(Imf::FLOAT, px.data() + k, dwin, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(dw)));
+    part.setFrameBuffer(fb);
+    part.readPixels(dwin.min.y, dwin.max.y);
+    if (!rgb)
+        for (std::size_t t = 0; 3 * t < px.size(); ++t) px[3 * t + 1] = px[3 * t + 2] = px[3 * t];
+}
+
+/// Luminance/chroma: OpenEXR's RgbaInputFile does the conversion (chroma reconstruction and
+/// YCA -> RGB with the file's chromaticities). It reads the first part of a file, so another part
+/// is first copied, still compressed, into a single-part file in memory.
+void read_exr_luma_chroma(Imf::MultiPartInputFile& file, int chosen, bool tiled, std::span<const unsigned char> bytes,
+                          const std::string& name, const Imath::Box2i& dwin, std::vector<float>& px) {
+    const int dw = dwin.max.x - dwin.min.x + 1;
+    std::vector<unsigned char> single;
+    std::span<const unsigned char> src = bytes;
+    if (chosen != 0 || file.parts() > 1) {
+        Imf::Header sh = file.header(chosen);
+        vector_ostream os(single);
+        if (tiled) {
+            Imf::TiledInputPart tin(file, chosen);
+            Imf::TiledOutputFile out(os, sh, exr_threads);
+            out.copyPixels(tin);
         } else {
-            fb.insert("Y", Imf::Slice::Make(Imf::FLOAT, px.data(), dwin, 3 * sizeof(float), 3 * sizeof(float) * std::size_t(dw)));
+            Imf::InputPart pin(file, chosen);
+            Imf::OutputFile out(os, sh, exr_threads);
+            out.copyPixels(pin);
         }
-        part.setFrameBuffer(fb);
-        part.readPixels(dwin.min.y, dwin.max.y);
-        if (!rgb)
-            for (std::size_t t = 0; t < dn; ++t) px[3 * t + 1] = px[3 * t + 2] = px[3 * t];
-    } else {
-        // Luminance/chroma: OpenEXR's RgbaInputFile does the conversion (chroma reconstruction and
-        // YCA -> RGB with the file's chromaticities). It reads the first part of a file, so another
-        // part is first copied, still compressed, into a single-part file in memory.
-        std::vector<unsigned char> single;
-        std::span<const unsigned char> src = bytes;
-        if (chosen != 0 || parts > 1) {
-            Imf::Header sh = H;
-            vector_ostream os(single);
-            if (tiled) {
-                Imf::TiledInputPart tin(file, chosen);
-                Imf::TiledOutputFile out(os, sh, exr_threads);
-                out.copyPixels(tin);
-            } else {
-                Imf::InputPart pin(file, chosen);
-                Imf::OutputFile out(os, sh, exr_threads);
-                out.copyPixels(pin);
-            }
-            src = single;
-        }
-        span_istream in2(src, name);
-        Imf::RgbaInputFile rin(in2, exr_threads);
-        std::vector<Imf::Rgba> rgba(dn);
-        // Base address of pixel (0, 0) in the data window's coordinates, computed on integers
-        // (the pointer itself may lie outside the buffer; OpenEXR only adds offsets back).
-        const std::intptr_t base = reinterpret_cast<std::intptr_t>(rgba.data()) -
-                                   (std::intptr_t(dwin.min.x) + std::intptr_t(dwin.min.y) * std::intptr_t(dw)) *
-                                       std::intptr_t(sizeof(Imf::Rgba));
-        rin.setFrameBuffer(reinterpret_cast<Imf::Rgba*>(base), 1, std::size_t(dw));
-        rin.readPixels(dwin.min.y, dwin.max.y);
-        for (std::size_t t = 0; t < dn; ++t) {
-            px[3 * t] = float(rgba[t].r);
-            px[3 * t + 1] = float(rgba[t].g);
-            px[3 * t + 2] = float(rgba[t].b);
-        }
+        src = single;
     }
+    span_istream in2(src, name);
+    Imf::RgbaInputFile rin(in2, exr_threads);
+    std::vector<Imf::Rgba> rgba(px.size() / 3);
+    // Base address of pixel (0, 0) in the data window's coordinates, computed on integers (the
+    // pointer itself may lie outside the buffer; OpenEXR only adds offsets back).
+    const std::intptr_t base = reinterpret_cast<std::intptr_t>(rgba.data()) -
+                               (std::intptr_t(dwin.min.x) + std::intptr_t(dwin.min.y) * std::intptr_t(dw)) * std::intptr_t(sizeof(Imf::Rgba));
+    rin.setFrameBuffer(reinterpret_cast<Imf::Rgba*>(base), 1, std::size_t(dw));
+    rin.readPixels(dwin.min.y, dwin.max.y);
+    for (std::size_t t = 0; t < rgba.size(); ++t) {
+        px[3 * t] = float(rgba[t].r);
+        px[3 * t + 1] = float(rgba[t].g);
+        px[3 * t + 2] = float(rgba[t].b);
+    }
+}
 
-    // The display window is the image: its pixels outside the data window are 0, data outside
-    // it is cropped.
+/// The display window is the image: its pixels outside the data window are 0, data outside it
+/// is cropped.
+image_rgb32f exr_display_image(std::vector<float>&& px, const Imath::Box2i& dwin, const Imath::Box2i& disp) {
+    const int dw = dwin.max.x - dwin.min.x + 1;
+    const int w = disp.max.x - disp.min.x + 1, h = disp.max.y - disp.min.y + 1;
     if (dwin == disp) {
         image_rgb32f img;
         img.width = w;
@@ -867,6 +886,30 @@ image_rgb32f decode_exr_part(std::span<const unsigned char> bytes, const std::st
             std::copy(s, s + 3, img.texel(x - disp.min.x, y - disp.min.y));
         }
     return img;
+}
+
+/// Reads the selected part's display window as RGB floats (see image_io.hpp for the rules).
+image_rgb32f decode_exr_part(std::span<const unsigned char> bytes, const std::string& name, const read_options& o,
+                             span_istream& in, std::string& detail) {
+    Imf::MultiPartInputFile file(in, exr_threads, true);
+    const int parts = file.parts();
+    const int chosen = choose_exr_part(file, name, o);
+    const exr_channels_kind kind = exr_kind(file, chosen, name, o);
+    const Imf::Header& H = file.header(chosen);
+    const Imath::Box2i dwin = H.dataWindow(), disp = H.displayWindow();
+    const int dw = dwin.max.x - dwin.min.x + 1, dh = dwin.max.y - dwin.min.y + 1;
+    check_dimensions(disp.max.x - disp.min.x + 1, disp.max.y - disp.min.y + 1, o, name, "OpenEXR display window"); // scanned already
+    check_dimensions(dw, dh, o, name, "OpenEXR data window");
+    const bool tiled = H.hasType() ? Imf::isTiled(H.type()) : Imf::isTiled(file.version());
+    detail = (parts > 1 ? "part " + std::to_string(chosen) + (H.hasName() ? " '" + printable(H.name(), 64) + "'" : std::string()) +
+                              " of " + std::to_string(parts) + ", "
+                        : std::string()) +
+             exr_compression_names[std::min<int>(H.compression(), int(std::size(exr_compression_names)) - 1)] +
+             (tiled ? ", tiled" : ", scanline") + (kind.rgb ? ", RGB" : kind.chroma ? ", Y/RY/BY" : ", Y");
+    std::vector<float> px(3 * std::size_t(dw) * std::size_t(dh), 0.0f);
+    if (kind.chroma) read_exr_luma_chroma(file, chosen, tiled, bytes, name, dwin, px);
+    else read_exr_rgb_or_y(file, chosen, kind.rgb, dwin, px);
+    return exr_display_image(std::move(px), dwin, disp);
 }
 
 } // namespace

@@ -282,6 +282,76 @@ cubemap_rgb32f cubemap_rgb32f::zeros(int size, int level_count) {
     return c;
 }
 
+namespace {
+
+/// One texel of `format` at b[at..] from RGB floats (alpha 1).
+void put_texel(std::vector<unsigned char>& b, std::size_t at, ktx2_format format, const float* px) {
+    switch (format) {
+    case ktx2_format::rgba32f:
+        for (int c = 0; c < 4; ++c) put32(b, at + 4 * std::size_t(c), std::bit_cast<std::uint32_t>(c < 3 ? px[c] : 1.0f));
+        break;
+    case ktx2_format::rgba16f:
+        for (int c = 0; c < 4; ++c) {
+            const std::uint16_t h = float_to_half(c < 3 ? px[c] : 1.0f);
+            b[at + 2 * std::size_t(c)] = static_cast<unsigned char>(h & 0xff);
+            b[at + 2 * std::size_t(c) + 1] = static_cast<unsigned char>(h >> 8);
+        }
+        break;
+    case ktx2_format::b10g11r11: put32(b, at, pack_b10g11r11(px[0], px[1], px[2])); break;
+    case ktx2_format::e5b9g9r9: put32(b, at, pack_e5b9g9r9(px[0], px[1], px[2])); break;
+    }
+}
+
+/// The Data Format Descriptor of `format` at b[d..] (total dfd_total bytes).
+void put_dfd(std::vector<unsigned char>& b, std::size_t d, ktx2_format format, std::uint32_t dfd_total, std::size_t tb) {
+    const std::vector<dfd_sample> samples = dfd_samples(format);
+    const std::uint32_t block_bytes = dfd_total - 4;
+    put32(b, d, dfd_total);
+    put32(b, d + 4, 0); // vendorId 0 (Khronos), descriptorType 0 (basic)
+    put32(b, d + 8, khr_df_version_1_3 | (block_bytes << 16));
+    put32(b, d + 12, khr_df_model_rgbsda | (khr_df_primaries_bt709 << 8) | (khr_df_transfer_linear << 16));
+    put32(b, d + 16, 0);                  // texelBlockDimension0..3 = 0 (1 texel)
+    put32(b, d + 20, std::uint32_t(tb));  // bytesPlane0
+    put32(b, d + 24, 0);                  // bytesPlane4..7
+    for (std::size_t i = 0; i < samples.size(); ++i) {
+        const std::size_t at = d + 28 + 16 * i;
+        const dfd_sample& sm = samples[i];
+        put32(b, at, sm.offset | ((sm.bits - 1) << 16) | (sm.channel << 24));
+        put32(b, at + 4, 0); // samplePosition
+        put32(b, at + 8, sm.lower);
+        put32(b, at + 12, sm.upper);
+    }
+
+}
+
+/// The key/value pairs, sorted by key (the KTX2 rule), KTXwriter among them; their total length.
+std::vector<std::pair<std::string, std::string>> ktx2_key_values(const std::string& writer, const std::string& name,
+                                                                 const std::vector<std::pair<std::string, std::string>>& metadata,
+                                                                 std::size_t& kvd_length) {
+    std::vector<std::pair<std::string, std::string>> kv = metadata;
+    kv.emplace_back("KTXwriter", writer);
+    std::sort(kv.begin(), kv.end());
+    for (std::size_t i = 0; i < kv.size(); ++i)
+        if (kv[i].first.empty() || kv[i].first.find('\0') != std::string::npos || kv[i].second.find('\0') != std::string::npos ||
+            (i > 0 && kv[i].first == kv[i - 1].first))
+            throw image_error(name, "bad KTX2 key/value metadata key '" + kv[i].first + "'");
+    kvd_length = 0;
+    for (const auto& [k, v] : kv) kvd_length += align_up(4 + k.size() + 1 + v.size() + 1, 4);
+    return kv;
+}
+
+void put_key_values(std::vector<unsigned char>& b, std::size_t at_kv, const std::vector<std::pair<std::string, std::string>>& kv) {
+    for (const auto& [k, v] : kv) {
+        const std::size_t len = k.size() + 1 + v.size() + 1;
+        put32(b, at_kv, std::uint32_t(len));
+        std::memcpy(b.data() + at_kv + 4, k.c_str(), k.size() + 1);
+        std::memcpy(b.data() + at_kv + 4 + k.size() + 1, v.c_str(), v.size() + 1);
+        at_kv += align_up(4 + len, 4);
+    }
+}
+
+} // namespace
+
 std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
                                                const std::string& name, ktx2_clamp_counts* counts,
                                                const std::vector<std::pair<std::string, std::string>>& metadata) {
@@ -293,16 +363,8 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
     const std::size_t tb = texel_bytes(format);
     const std::size_t dfd_offset = header_bytes + level_entry_bytes * L;
     const std::size_t kvd_offset = dfd_offset + dfd_total;
-    // Key/value pairs sorted by key (the KTX2 rule): KTXwriter, then the caller's metadata.
-    std::vector<std::pair<std::string, std::string>> kv = metadata;
-    kv.emplace_back("KTXwriter", writer);
-    std::sort(kv.begin(), kv.end());
-    for (std::size_t i = 0; i < kv.size(); ++i)
-        if (kv[i].first.empty() || kv[i].first.find('\0') != std::string::npos || kv[i].second.find('\0') != std::string::npos ||
-            (i > 0 && kv[i].first == kv[i - 1].first))
-            throw image_error(name, "bad KTX2 key/value metadata key '" + kv[i].first + "'");
     std::size_t kvd_length = 0;
-    for (const auto& [k, v] : kv) kvd_length += align_up(4 + k.size() + 1 + v.size() + 1, 4);
+    const std::vector<std::pair<std::string, std::string>> kv = ktx2_key_values(writer, name, metadata, kvd_length);
     std::size_t pos = kvd_offset + kvd_length;
 
     // Level placement, smallest level first.
@@ -339,35 +401,9 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
         put64(b, at + 16, length[l]);
     }
 
-    // Data format descriptor.
-    const std::vector<dfd_sample> samples = dfd_samples(format);
-    const std::uint32_t block_bytes = dfd_total - 4;
-    std::size_t d = dfd_offset;
-    put32(b, d, dfd_total);
-    put32(b, d + 4, 0); // vendorId 0 (Khronos), descriptorType 0 (basic)
-    put32(b, d + 8, khr_df_version_1_3 | (block_bytes << 16));
-    put32(b, d + 12, khr_df_model_rgbsda | (khr_df_primaries_bt709 << 8) | (khr_df_transfer_linear << 16));
-    put32(b, d + 16, 0);                  // texelBlockDimension0..3 = 0 (1 texel)
-    put32(b, d + 20, std::uint32_t(tb));  // bytesPlane0
-    put32(b, d + 24, 0);                  // bytesPlane4..7
-    for (std::size_t i = 0; i < samples.size(); ++i) {
-        const std::size_t at = d + 28 + 16 * i;
-        const dfd_sample& sm = samples[i];
-        put32(b, at, sm.offset | ((sm.bits - 1) << 16) | (sm.channel << 24));
-        put32(b, at + 4, 0); // samplePosition
-        put32(b, at + 8, sm.lower);
-        put32(b, at + 12, sm.upper);
-    }
+    put_dfd(b, dfd_offset, format, dfd_total, tb);
 
-    // Key/value data.
-    std::size_t at_kv = kvd_offset;
-    for (const auto& [k, v] : kv) {
-        const std::size_t len = k.size() + 1 + v.size() + 1;
-        put32(b, at_kv, std::uint32_t(len));
-        std::memcpy(b.data() + at_kv + 4, k.c_str(), k.size() + 1);
-        std::memcpy(b.data() + at_kv + 4 + k.size() + 1, v.c_str(), v.size() + 1);
-        at_kv += align_up(4 + len, 4);
-    }
+    put_key_values(b, kvd_offset, kv);
 
     // Texels.
     ktx2_clamp_counts seen;
@@ -379,20 +415,7 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
             for (std::size_t t = 0; t < s * s; ++t) {
                 const float* px = src.data() + 3 * t;
                 count_clamps(format, px, seen);
-                switch (format) {
-                case ktx2_format::rgba32f:
-                    for (int c = 0; c < 4; ++c) put32(b, at + 4 * std::size_t(c), std::bit_cast<std::uint32_t>(c < 3 ? px[c] : 1.0f));
-                    break;
-                case ktx2_format::rgba16f:
-                    for (int c = 0; c < 4; ++c) {
-                        const std::uint16_t h = float_to_half(c < 3 ? px[c] : 1.0f);
-                        b[at + 2 * std::size_t(c)] = static_cast<unsigned char>(h & 0xff);
-                        b[at + 2 * std::size_t(c) + 1] = static_cast<unsigned char>(h >> 8);
-                    }
-                    break;
-                case ktx2_format::b10g11r11: put32(b, at, pack_b10g11r11(px[0], px[1], px[2])); break;
-                case ktx2_format::e5b9g9r9: put32(b, at, pack_e5b9g9r9(px[0], px[1], px[2])); break;
-                }
+                put_texel(b, at, format, px);
                 at += tb;
             }
         }
