@@ -15,6 +15,7 @@
 #include <doctest/doctest.h>
 
 #include "image_io.hpp"
+#include "tool_test_support.hpp"
 #include "json_value.hpp"
 
 #include <cmath>
@@ -42,34 +43,18 @@
 
 namespace fs = std::filesystem;
 using namespace ibl_bake;
+using ibl_bake_test::scratch;
+using ibl_bake_test::shell;
+using ibl_bake_test::slurp;
 
 namespace {
 
 const std::string tool = IBL_BAKE_TOOL;
 const std::string data_dir = IBL_BAKE_TEST_DATA_DIR;
 
-std::string slurp(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
-
-struct scratch {
-    fs::path path;
-    scratch() : path(fs::temp_directory_path() / ("ibl_bake_exr_bakes_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~scratch() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& n) const { return (path / n).string(); }
-};
-
 int bake(const std::string& in, const std::string& out) {
     const std::string cmd = tool + " --quiet --quality low --lut-size 16 --size 16 --input '" + in + "' --out '" + out + "' >/dev/null 2>&1";
-    const int st = std::system(cmd.c_str());
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return shell(cmd);
 }
 
 /// The original's half RGB planes.
@@ -176,7 +161,7 @@ double level_rel_rms(const std::string& a, const std::string& b, int l) {
 } // namespace
 
 TEST_CASE("exr bakes: every encoding of the lat-long bakes to the original's products") {
-    scratch s;
+    scratch s("ibl_bake_exr_bakes");
     const planes p = read_original();
     REQUIRE(bake(data_dir + "/courtyard.exr", s / "ref") == 0);
     struct variant {

@@ -10,6 +10,7 @@
 #include <doctest/doctest.h>
 
 #include "image_io.hpp"
+#include "tool_test_support.hpp"
 #include "json_value.hpp"
 
 #include <cmath>
@@ -25,6 +26,9 @@
 
 namespace fs = std::filesystem;
 using namespace ibl_bake;
+using ibl_bake_test::scratch;
+using ibl_bake_test::shell;
+using ibl_bake_test::slurp;
 
 namespace {
 
@@ -32,29 +36,11 @@ const std::string tool = IBL_BAKE_TOOL;
 const std::string data_dir = IBL_BAKE_TEST_DATA_DIR;
 const char* faces[6] = {"px", "nx", "py", "ny", "pz", "nz"};
 
-std::string slurp(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
-
-struct scratch {
-    fs::path path;
-    scratch() : path(fs::temp_directory_path() / ("ibl_bake_input_tests_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~scratch() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& n) const { return (path / n).string(); }
-};
-
 int run(const scratch& s, const std::string& args, std::string* err = nullptr) {
     const std::string e = s / "stderr.txt";
-    const int st = std::system((tool + " --quiet --quality low --lut-size 16 " + args + " >/dev/null 2>" + e).c_str());
+    const int st = shell(tool + " --quiet --quality low --lut-size 16 " + args + " >/dev/null 2>" + e);
     if (err) *err = slurp(e);
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+    return st;
 }
 
 std::vector<double> sh_radiance(const std::string& dir) {
@@ -83,7 +69,7 @@ double level_rel_rms(const std::string& a, const std::string& b, int l) {
 } // namespace
 
 TEST_CASE("inputs: six faces and a cross give the lat-long's products") {
-    scratch s;
+    scratch s("ibl_bake_input_tests");
     const std::string ll = data_dir + "/courtyard.exr";
     REQUIRE(run(s, "--input " + ll + " --size 64 --levels 1 --layout faces,cross,latlong --out " + (s / "cube64")) == 0);
     REQUIRE(run(s, "--input " + ll + " --size 16 --out " + (s / "from_latlong")) == 0);
@@ -115,7 +101,7 @@ TEST_CASE("inputs: six faces and a cross give the lat-long's products") {
 }
 
 TEST_CASE("inputs: a mis-sized or mislabelled cross is refused") {
-    scratch s;
+    scratch s("ibl_bake_input_tests");
     write_exr(s / "odd.exr", image_rgb32f(40, 31)); // neither 2:1, 4:3, 3:4 nor a strip
     std::string err;
     CHECK(run(s, "--input " + (s / "odd.exr") + " --size 16 --out " + (s / "o1"), &err) == 1);

@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 
 #include "image_io.hpp"
+#include "tool_test_support.hpp"
 #include "json_value.hpp"
 #include "ktx2.hpp"
 
@@ -33,35 +34,15 @@
 
 namespace fs = std::filesystem;
 using namespace ibl_bake;
+using ibl_bake_test::scratch;
+using ibl_bake_test::shell;
+using ibl_bake_test::slurp;
 using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 
 namespace {
 
 const std::string tool = IBL_BAKE_TOOL;
-
-std::string slurp(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
-
-struct scratch {
-    fs::path path;
-    scratch() : path(fs::temp_directory_path() / ("ibl_bake_lookup_tests_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~scratch() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& n) const { return (path / n).string(); }
-};
-
-int sh(const std::string& cmd) {
-    const int st = std::system(cmd.c_str());
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
 
 ibl::cubemap<float> load_chain(const std::string& path) {
     const std::string b = slurp(path);
@@ -115,9 +96,9 @@ void check_close(const std::vector<double>& got, const std::vector<double>& want
 } // namespace
 
 TEST_CASE("lookup: answers equal the library's runtime functions on the bake's files") {
-    scratch s;
+    scratch s("ibl_bake_lookup_tests");
     // SH diffuse and no extracted sun here; the next case checks the default (map + sun) answers.
-    REQUIRE(sh(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --out " + (s / "bake") +
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --out " + (s / "bake") +
                " >/dev/null 2>&1") == 0);
     const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
     const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
@@ -167,7 +148,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         for (const auto& x : q) all += x + "\n";
         return all;
     }();
-    REQUIRE(sh(tool + " --lookup " + (s / "bake") + " < " + (s / "queries.txt") + " > " + (s / "answers.txt")) == 0);
+    REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "queries.txt") + " > " + (s / "answers.txt")) == 0);
     std::istringstream answers(slurp(s / "answers.txt"));
     std::string line;
     std::size_t n = 0;
@@ -180,19 +161,19 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
     CHECK(n == want.size());
 
     std::ofstream(s / "bad.txt") << "specular 0 1 0\nfoo 1 2\ndfg 0.5 x\nirradiance 0 0 0\ndfg 0.5 0.5\n";
-    CHECK(sh(tool + " --lookup " + (s / "bake") + " < " + (s / "bad.txt") + " > " + (s / "bad_answers.txt")) == 1);
+    CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "bad.txt") + " > " + (s / "bad_answers.txt")) == 1);
     const std::string bad = slurp(s / "bad_answers.txt");
     CHECK(bad.find("error: line 1: 'specular' takes 4 numbers") != std::string::npos);
     CHECK(bad.find("error: line 2: unknown query 'foo'") != std::string::npos);
     CHECK(bad.find("error: line 3: expected numbers") != std::string::npos);
     CHECK(bad.find("error: line 4: the normal is zero") != std::string::npos);
     CHECK(std::count(bad.begin(), bad.end(), '\n') == 5); // one line per query, the last one answered
-    CHECK(sh(tool + " --lookup " + (s / "nothing") + " < /dev/null > /dev/null 2>&1") == 1);
+    CHECK(shell(tool + " --lookup " + (s / "nothing") + " < /dev/null > /dev/null 2>&1") == 1);
 }
 
 TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers are about the whole environment") {
-    scratch s;
-    REQUIRE(sh(tool + " --quiet --size 32 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
+    scratch s("ibl_bake_lookup_tests");
+    REQUIRE(shell(tool + " --quiet --size 32 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
     const ibl_examples::json_value lights = ibl_examples::parse_json(slurp(s / "bake/lights.json"));
     const auto& list = lights.find("lights")->values;
     REQUIRE(list.size() == 1); // the built-in sky's sun
@@ -218,7 +199,7 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
             want.push_back({e.x, e.y, e.z});
         }
     std::ofstream(s / "q.txt") << q;
-    REQUIRE(sh(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
+    REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
     std::istringstream answers(slurp(s / "a.txt"));
     std::string line;
     std::size_t n = 0;

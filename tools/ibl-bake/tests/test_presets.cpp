@@ -9,6 +9,7 @@
 #include <doctest/doctest.h>
 
 #include "image_io.hpp"
+#include "tool_test_support.hpp"
 #include "json_value.hpp"
 #include "ktx2.hpp"
 
@@ -25,42 +26,22 @@
 
 namespace fs = std::filesystem;
 using namespace ibl_bake;
+using ibl_bake_test::scratch;
+using ibl_bake_test::shell;
+using ibl_bake_test::slurp;
 
 namespace {
 
 const std::string tool = IBL_BAKE_TOOL;
 
-std::string slurp(const std::string& path) {
-    std::ifstream f(path, std::ios::binary);
-    return std::string(std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>());
-}
-
-int sh(const std::string& cmd) {
-    const int st = std::system(cmd.c_str());
-    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-}
-
-struct scratch {
-    fs::path path;
-    scratch() : path(fs::temp_directory_path() / ("ibl_bake_preset_tests_" + std::to_string(::getpid()))) {
-        fs::remove_all(path);
-        fs::create_directories(path);
-    }
-    ~scratch() {
-        std::error_code ec;
-        fs::remove_all(path, ec);
-    }
-    std::string operator/(const std::string& n) const { return (path / n).string(); }
-};
-
 } // namespace
 
 TEST_CASE("presets: filament and gltf change the documented conventions") {
-    scratch s;
+    scratch s("ibl_bake_preset_tests");
     const std::string base = tool + " --quiet --size 32 --quality low --lut-size 32 ";
-    REQUIRE(sh(base + "--preset filament --out " + (s / "fil") + " >/dev/null") == 0);
-    REQUIRE(sh(base + "--preset gltf --out " + (s / "gltf") + " >/dev/null") == 0);
-    REQUIRE(sh(base + "--dfg-layout uniform --specular-lookup textbook --extract-sun off --irradiance-size 0 --out " + (s / "ref") +
+    REQUIRE(shell(base + "--preset filament --out " + (s / "fil") + " >/dev/null") == 0);
+    REQUIRE(shell(base + "--preset gltf --out " + (s / "gltf") + " >/dev/null") == 0);
+    REQUIRE(shell(base + "--dfg-layout uniform --specular-lookup textbook --extract-sun off --irradiance-size 0 --out " + (s / "ref") +
                " >/dev/null") == 0);
     const auto fil = ibl_examples::parse_json(slurp(s / "fil/report.json"));
     const auto ref = ibl_examples::parse_json(slurp(s / "ref/report.json"));
@@ -88,8 +69,8 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
         }
     // --lookup undoes the channel layout: the same (A, B) from both folders
     std::ofstream(s / "q.txt") << "dfg 0.3 0.4\ndfg 0.02 0.9\n";
-    REQUIRE(sh(tool + " --lookup " + (s / "fil") + " < " + (s / "q.txt") + " > " + (s / "af.txt")) == 0);
-    REQUIRE(sh(tool + " --lookup " + (s / "ref") + " < " + (s / "q.txt") + " > " + (s / "ar.txt")) == 0);
+    REQUIRE(shell(tool + " --lookup " + (s / "fil") + " < " + (s / "q.txt") + " > " + (s / "af.txt")) == 0);
+    REQUIRE(shell(tool + " --lookup " + (s / "ref") + " < " + (s / "q.txt") + " > " + (s / "ar.txt")) == 0);
     CHECK(slurp(s / "af.txt") == slurp(s / "ar.txt"));
     // the KTX2 records the loader's facts
     const std::string k = slurp(s / "fil/specular.ktx2");
