@@ -45,6 +45,8 @@ namespace fs = std::filesystem;
 using namespace ibl_bake;
 using ibl_bake_test::scratch;
 using ibl_bake_test::shell;
+using ibl_bake_test::level_rel_rms;
+using ibl_bake_test::sh_radiance;
 using ibl_bake_test::slurp;
 
 namespace {
@@ -135,27 +137,6 @@ void write_multipart(const planes& p, const std::string& path) {
     a.writePixels(p.h);
     b.setFrameBuffer(frame(p, false, wide));
     b.writePixels(p.h);
-}
-
-std::vector<double> sh_radiance(const std::string& dir) {
-    const ibl_examples::json_value v = ibl_examples::parse_json(slurp(dir + "/sh.json"));
-    std::vector<double> out;
-    for (const auto& t : v.find("radiance")->values)
-        for (const auto& c : t.values) out.push_back(c.number);
-    return out;
-}
-
-double level_rel_rms(const std::string& a, const std::string& b, int l) {
-    double num = 0.0, den = 0.0;
-    for (const char* f : {"px", "nx", "py", "ny", "pz", "nz"}) {
-        const std::string name = "/specular_l" + std::to_string(l) + "_" + f + ".exr";
-        const image_rgb32f x = read_image(a + name), y = read_image(b + name);
-        for (std::size_t i = 0; i < x.rgb.size(); ++i) {
-            num += (double(x.rgb[i]) - y.rgb[i]) * (double(x.rgb[i]) - y.rgb[i]);
-            den += double(y.rgb[i]) * y.rgb[i];
-        }
-    }
-    return std::sqrt(num / den);
 }
 
 } // namespace

@@ -28,42 +28,20 @@ namespace fs = std::filesystem;
 using namespace ibl_bake;
 using ibl_bake_test::scratch;
 using ibl_bake_test::shell;
+using ibl_bake_test::level_rel_rms;
+using ibl_bake_test::sh_radiance;
 using ibl_bake_test::slurp;
 
 namespace {
 
 const std::string tool = IBL_BAKE_TOOL;
 const std::string data_dir = IBL_BAKE_TEST_DATA_DIR;
-const char* faces[6] = {"px", "nx", "py", "ny", "pz", "nz"};
 
 int run(const scratch& s, const std::string& args, std::string* err = nullptr) {
     const std::string e = s / "stderr.txt";
     const int st = shell(tool + " --quiet --quality low --lut-size 16 " + args + " >/dev/null 2>" + e);
     if (err) *err = slurp(e);
     return st;
-}
-
-std::vector<double> sh_radiance(const std::string& dir) {
-    const ibl_examples::json_value v = ibl_examples::parse_json(slurp(dir + "/sh.json"));
-    std::vector<double> out;
-    for (const auto& t : v.find("radiance")->values)
-        for (const auto& c : t.values) out.push_back(c.number);
-    return out;
-}
-
-/// Relative RMS difference of every texel of specular level l (all faces) between two bakes.
-double level_rel_rms(const std::string& a, const std::string& b, int l) {
-    double num = 0.0, den = 0.0;
-    for (const char* f : faces) {
-        const std::string name = "/specular_l" + std::to_string(l) + "_" + f + ".exr";
-        const image_rgb32f x = read_image(a + name), y = read_image(b + name);
-        REQUIRE(x.rgb.size() == y.rgb.size());
-        for (std::size_t i = 0; i < x.rgb.size(); ++i) {
-            num += (double(x.rgb[i]) - y.rgb[i]) * (double(x.rgb[i]) - y.rgb[i]);
-            den += double(y.rgb[i]) * y.rgb[i];
-        }
-    }
-    return std::sqrt(num / den);
 }
 
 } // namespace
