@@ -81,6 +81,7 @@
 #include "../env/environment.hpp"
 #include "../sampling/hemisphere.hpp"
 #include "../sampling/sequence.hpp"
+#include "prefilter.hpp"
 #include "sphere_convolve.hpp"
 
 namespace ibl {
@@ -313,6 +314,32 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
     const std::vector<vec3<float>> texels = convolve_faces(env, make_irradiance_table_for<float>(env, opt), n, ex);
     out.fill(0, [&](int f, int x, int y) {
         return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
+    });
+    out.update_borders();
+    return out;
+}
+
+/// Irradiance through the lobe-generic prefilter (integrate/prefilter.hpp): a one-level cubemap of
+/// face `size` holding pi times the normalised mean of the source over lobe L about each texel's
+/// direction, by `samples` draws of L (filtered importance sampling: each draw reads the source
+/// at the lod of its solid angle 1 / (N pdf_l), bias `lod_bias`). With the default cosine_lobe
+/// this is E(n) (the cosine-importance irradiance of irradiance_cubemap, through the same
+/// integrator as the specular and sheen chains); another lobe (sampling/lobe.hpp's contract)
+/// gives pi times its weighted mean: a wrapped or rough diffuse kernel runs through it unchanged.
+/// `lobe_roughness` is passed to the lobe (the cosine lobe ignores it). Limits as prefilter.
+template <class Lobe = cosine_lobe, class Env, class Executor = serial_executor>
+    requires ld_lobe<Lobe>
+cubemap<float> irradiance_cubemap_lobe(const Env& env, int size, std::uint32_t samples, Executor&& ex = Executor{},
+                                       double lobe_roughness = 0.0, double lod_bias = 0.5) {
+    detail::check_arg("irradiance_cubemap_lobe", "size", size, 1, limits::max_face_size, "limits::max_face_size");
+    detail::check_total("irradiance_cubemap_lobe", "samples", samples, limits::max_samples, "limits::max_samples");
+    sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(env, lobe_roughness, samples, prefilter_method::filtered_importance, lod_bias);
+    table.trilinear = true;
+    table.scale = float(pi_v<double>); // E = pi x the normalised lobe mean
+    cubemap<float> out(size, 1);
+    const std::vector<vec3<float>> texels = convolve_faces(env, table, size, ex);
+    out.fill(0, [&](int f, int x, int y) {
+        return texels[(std::size_t(f) * std::size_t(size) + std::size_t(y)) * std::size_t(size) + std::size_t(x)];
     });
     out.update_borders();
     return out;

@@ -98,6 +98,35 @@ struct ggx_lobe {
     }
 };
 
+/// The clamped-cosine lobe about N (= R in the prefilter's frame): the diffuse kernel, so that the
+/// lobe-generic prefilter is also an irradiance integrator (integrate/irradiance.hpp
+/// irradiance_cubemap_lobe: E = pi x the lobe's normalised mean). l is drawn with density
+/// cos(theta_l) / pi (sample_cosine_hemisphere), h = normalize(l + n); ld_weight cancels the
+/// estimator's n.l factor (weight 1 per draw); roughness is unused. A user-defined diffuse lobe
+/// (a wrapped cosine, a rough diffuse model's kernel) follows the same pattern.
+struct cosine_lobe {
+    static constexpr const char* name = "cosine";
+    static constexpr bool mirror_limit = false;
+
+    IBL_FUNC static vec3<double> sample(const vec2<double>& u, double) noexcept {
+        const vec3<double> l = sample_cosine_hemisphere(u);
+        const vec3<double> h(l.x, l.y, l.z + 1.0);
+        const double len = std::sqrt(h.x * h.x + h.y * h.y + h.z * h.z);
+        return h / len;
+    }
+    /// Density of h: pdf_l |dl/dh| = (n.l / pi) 4 (n.h) with n.l = 2 (n.h)^2 - 1.
+    IBL_FUNC static double pdf(const vec3<double>& h, double roughness) noexcept { return 4.0 * h.z * ld_pdf(h, roughness); }
+    IBL_FUNC static double ld_pdf(const vec3<double>& h, double) noexcept {
+        const double n_dot_l = 2.0 * h.z * h.z - 1.0;
+        return n_dot_l > 0.0 ? n_dot_l * inv_pi_v<double> : 0.0;
+    }
+    /// 1 / (n.l): every draw of the (already cosine-distributed) set weighs the same.
+    IBL_FUNC static double ld_weight(const vec3<double>& h, double) noexcept {
+        const double n_dot_l = 2.0 * h.z * h.z - 1.0;
+        return n_dot_l > 0.0 ? 1.0 / n_dot_l : 0.0;
+    }
+};
+
 namespace detail {
 /// The Charlie LD kernel's radial variable: z >= 0 with CDF
 ///   G(z) = int_0^z e^-t (1 - e^(-a t)) dt / M,  M = a / (1 + a),
