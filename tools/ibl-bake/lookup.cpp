@@ -139,7 +139,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen chain (bake with --sheen)");
         const dvec3 d = unit(a[0], a[1], a[2], "the direction");
         const float lod = ibl::roughness_mip_policy::linear().lod(float(unit_interval(a[3])), b.sheen.levels());
-        return triple(dvec3(b.sheen.radiance(fvec3(d), lod)));
+        return triple(dvec3(b.sheen.radiance(fvec3(d), lod)) + sheen_sun_ld(v.sun, d, unit_interval(a[3])));
     }
     if (word == "dfg_sheen") {
         need(2);

@@ -12,8 +12,8 @@
 //                                 pbr_shader ambient, multiple scattering) for normal N, view V
 //                                 (towards the eye; both normalised), roughness R, metallic M,
 //                                 base colour B
-//   sheen X Y Z R               -> r g b   Charlie LD of the whole environment (a --sheen bake: the sheen
-//                                 chain, baked before sun extraction), textureLod at lod = r (V - 1)
+//   sheen X Y Z R               -> r g b   Charlie LD of the whole environment (a --sheen bake): the sheen
+//                                 chain at lod = r (V - 1) plus an extracted sun's Charlie term
 //   dfg_sheen NV R              -> E       the sheen albedo lookup (bilinear, texel centres)
 // With a sun in lights.json the answers are about the whole environment: specular adds the sun's
 // exact LD term (ibl::disk_light_ld), irradiance its cap irradiance, shade its disk-light shading.

@@ -11,7 +11,9 @@
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/prefilter.hpp>
+#include <ibl/brdf/charlie.hpp>
 #include <ibl/integrate/disk_light.hpp>
+#include <ibl/sampling/lobe.hpp>
 #include <ibl/integrate/reference.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
@@ -49,6 +51,22 @@ dvec3 product_view::irradiance(const dvec3& n) const {
 
 dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness) {
     return sun ? ibl::disk_light_ld(*sun, d, roughness, 8) : dvec3(0.0); // 8 nodes agree with 128 to 1e-13 (docs/sun.md)
+}
+
+dvec3 sheen_sun_ld(const ibl::disk_light<double>* sun, const dvec3& R, double roughness) {
+    if (!sun) return dvec3(0.0);
+    const double alpha = ibl::charlie_lobe::alpha(roughness);
+    const double c = glm::dot(R, sun->direction);
+    if (!(c > 0.0)) return dvec3(0.0);
+    constexpr int m = 2048;
+    double w = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double t = (i + 0.5) * ibl::half_pi_v<double> / m;
+        w += ibl::ndf_charlie(std::cos(0.5 * t), alpha) * std::cos(t) * std::sin(t);
+    }
+    w *= ibl::two_pi_v<double> * ibl::half_pi_v<double> / m;
+    const double d = ibl::ndf_charlie(std::sqrt(0.5 * (1.0 + c)), alpha) * c;
+    return w > 0.0 ? sun->radiance * (sun->solid_angle * d / w) : dvec3(0.0);
 }
 
 ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {

@@ -4,11 +4,12 @@
 //                tool's chain (roughness r = v / (V - 1), the sheen roughness), by filtered
 //                importance sampling of the Charlie lobe (ibl::prefilter<ibl::charlie_lobe>: level
 //                0 convolved too, the Charlie lobe at r -> 0 is a ring, not a mirror), from the
-//                source BEFORE sun extraction: the sheen chain holds the whole environment.
+//                source after sun extraction; the runtime adds the sun's Charlie LD term
+//                (sheen_sun_ld: the disk's centre-point weight over the lobe's normaliser).
 //   sheen LUT    the sheen albedo E(n.v, r) = integral D V n.l (Neubelt's V) by quadrature
 //                (ibl::make_sheen_lut), the DFG table's texel-centre layout (x = n.v, y = r).
-// Checks: each level against the exact Charlie LD of the source cube by a texel sum (the GGX
-// check texels);
+// Checks: each level plus the sun's term against the exact Charlie LD of the source before
+// extraction by a texel sum (the GGX check texels);
 // the LUT at 16 x 16 texels against ibl::sheen_albedo (double, its own nodes).
 
 #include "stages.hpp"
@@ -48,7 +49,8 @@ public:
         po.samples_per_level.assign(std::size_t(po.levels), 0u);
         for (int l = 0; l < po.levels; ++l) po.samples_per_level[std::size_t(l)] = ibl::doubling_prefilter_samples(ctx.qs.prefilter_samples, std::max(l, 1));
         ctx.prog.begin("sheen");
-        chain_ = ibl::prefilter<ibl::charlie_lobe>(ctx.whole_source(), po, ctx.ex);
+        chain_ = ibl::prefilter<ibl::charlie_lobe>(ctx.source, po, ctx.ex); // the residual when a sun was extracted
+        sun_ = ctx.sun ? &*ctx.sun : nullptr;
         lut_ = ibl::make_sheen_lut(std::uint32_t(ctx.opt.lut_size), ibl::sheen_lut_default_nodes, ctx.ex);
         ms_ = ctx.prog.end();
         format_ = ctx.opt.ktx2_format;
@@ -69,7 +71,7 @@ public:
         double worst = 0.0;
         for (const auto& m : levels_)
             if (std::isfinite(m.rel_rmse)) worst = std::max(worst, m.rel_rmse);
-        return {{"sheen chain", "Charlie filtered IS (whole source)", std::to_string(chain_.levels()) + " levels", ms_,
+        return {{"sheen chain", std::string("Charlie filtered IS") + (sun_ ? " + sun term" : ""), std::to_string(chain_.levels()) + " levels", ms_,
                  fmt("worst rel RMSE (levels >= 1) %.3g vs texel-sum Charlie LD", worst)},
                 {"sheen lut", "quadrature (Neubelt V)", std::to_string(lut_.size) + "^2", -1.0, fmt("max abs %.3g vs sheen_albedo", lut_max_abs_)}};
     }
@@ -100,7 +102,7 @@ private:
         const int n = chain_.size(l);
         const double r = ibl::roughness_mip_policy::linear().roughness(double(l), chain_.levels());
         const double alpha = ibl::charlie_lobe::alpha(r);
-        const ibl::cubemap<float>& src = ctx.whole_source();
+        const ibl::cubemap<float>& src = ctx.whole_source(); // the whole environment: the runtime adds the sun
         const int sl = level_at_most(src, 64), m = src.size(sl);
         std::vector<dvec3> td, tl;
         std::vector<double> tw;
@@ -129,7 +131,10 @@ private:
             }
         });
         ibl::error_accumulator acc(1e-3 * std::max(ctx.lstats.mean, 1e-30));
-        for (std::size_t i = 0; i < tex.size(); ++i) acc.add(dvec3(chain_.texel(tex[i][0], tex[i][1], tex[i][2], l)), ref[i]);
+        for (std::size_t i = 0; i < tex.size(); ++i) {
+            const dvec3 R = ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n);
+            acc.add(dvec3(chain_.texel(tex[i][0], tex[i][1], tex[i][2], l)) + sheen_sun_ld(sun_, R, r), ref[i]);
+        }
         return acc.finish();
     }
     void check_lut(pool_executor& ex) {
@@ -145,6 +150,7 @@ private:
     }
 
     ibl::cubemap<float> chain_{1};
+    const ibl::disk_light<double>* sun_ = nullptr;
     ibl::dfg_lut lut_;
     std::string format_;
     std::vector<std::uint32_t> samples_;
@@ -155,7 +161,8 @@ private:
 void sheen_stage::report(json_writer& j) const {
     j.begin_object();
     j.key("files").value("sheen_l{level}_{px,nx,py,ny,pz,nz}.exr, sheen.ktx2, sheen_lut.exr (R = E)");
-    j.key("method").value("Charlie NDF LD (N = V = R) by filtered importance sampling of the Charlie lobe, from the whole source; "
+    j.key("method").value("Charlie NDF LD (N = V = R) by filtered importance sampling of the Charlie lobe, from the source after "
+                          "sun extraction (the runtime adds the sun's Charlie term); "
                           "sheen albedo E(n.v, r) with Neubelt's visibility by quadrature");
     j.key("lookup").value("chain: textureLod at lod = r (V - 1) (linear policy); LUT: bilinear at x = n.v, y = r, texel centres (i + 0.5) / N");
     j.key("samples_per_level").begin_array();

@@ -94,6 +94,13 @@ dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
 /// The sun's LD at direction d and roughness r (its exact term, host quadrature); 0 without one.
 dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness);
 
+/// An extracted sun's term of the Charlie (sheen) LD at R and sheen roughness r: the disk's
+/// radiance x solid angle x D(h_c) (n.l_c) at its centre, over the lobe's normaliser
+/// W(r) = 2 pi int_0^{pi/2} D(cos(theta / 2)) cos(theta) sin(theta) d theta (2048-node midpoint).
+/// The centre-point rule is exact to ~(disk radius / lobe width)^2: 1e-3 for a 1-degree sun at
+/// r >= 0.25. 0 without a sun.
+dvec3 sheen_sun_ld(const ibl::disk_light<double>* sun, const dvec3& R, double roughness);
+
 /// The first level of `cube` whose face is <= max_face (the last level if none is):
 /// ibl::irradiance_texel_sum_level.
 int level_at_most(const ibl::cubemap<float>& cube, int max_face);

@@ -210,3 +210,42 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
     }
     CHECK(n == want.size());
 }
+
+TEST_CASE("lookup: sheen and dfg_sheen answer from the sheen chain and table") {
+    scratch s("ibl_bake_lookup_sheen");
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --sheen --extract-sun off --out " + (s / "bake") +
+                  " >/dev/null 2>&1") == 0);
+    const ibl::cubemap<float> sheen = load_chain(s / "bake/sheen.ktx2");
+    const image_rgb32f lut_img = read_image(s / "bake/sheen_lut.exr");
+    ibl::dfg_lut lut{std::uint32_t(lut_img.width), 1, {}};
+    for (int j = 0; j < lut_img.height; ++j)
+        for (int i = 0; i < lut_img.width; ++i) lut.data.push_back(lut_img.texel(i, j)[0]);
+    std::string q;
+    std::vector<std::vector<double>> want;
+    for (int k = 0; k < 12; ++k) {
+        const dvec3 d = glm::normalize(dvec3(std::sin(0.7 * k), 0.4 - 0.05 * k, std::cos(0.7 * k)));
+        const double r = std::fmod(0.09 * k + 0.02, 1.0), nv = std::fmod(0.13 * k + 0.01, 1.0);
+        char buf[200];
+        std::snprintf(buf, sizeof buf, "sheen %.17g %.17g %.17g %.17g\ndfg_sheen %.17g %.17g\n", d.x, d.y, d.z, r, nv, r);
+        q += buf;
+        const fvec3 ld = sheen.radiance(fvec3(d), ibl::roughness_mip_policy::linear().lod(float(r), sheen.levels()));
+        want.push_back({ld.x, ld.y, ld.z});
+        want.push_back({lut.sample(float(nv), float(r)).x});
+    }
+    std::ofstream(s / "q.txt") << q;
+    REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
+    std::istringstream answers(slurp(s / "a.txt"));
+    std::string line;
+    std::size_t n = 0;
+    while (std::getline(answers, line)) {
+        REQUIRE(n < want.size());
+        check_close(numbers(line), want[n]);
+        ++n;
+    }
+    CHECK(n == want.size());
+    // a bake without --sheen says so
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --out " + (s / "plain") + " >/dev/null 2>&1") == 0);
+    std::ofstream(s / "q2.txt") << "sheen 0 1 0 0.5\n";
+    CHECK(shell(tool + " --lookup " + (s / "plain") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
+    CHECK(slurp(s / "a2.txt").find("bake with --sheen") != std::string::npos);
+}
