@@ -104,6 +104,7 @@ public:
     void run(bake_context& ctx) override {
         bands_ = ctx.opt.sh_bands > 0 ? ctx.opt.sh_bands : ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
         window_ = ctx.opt.sh_window;
+        filament_ = ctx.opt.preset == "filament";
         texels_ = 6 * ctx.source.size(0) * ctx.source.size(0);
         ctx.prog.begin("sh");
         switch (bands_) {
@@ -133,11 +134,27 @@ public:
         return {{"sh irradiance", method, std::to_string(texels_) + " texels", ms_, err}};
     }
     std::vector<file_out> files() const override {
-        return {{"sh.json", [this](const std::string& p) { write_text(p, sh_json()); }}};
+        std::vector<file_out> f{{"sh.json", [this](const std::string& p) { write_text(p, sh_json()); }}};
+        if (filament_) f.push_back({"sh.txt", [this](const std::string& p) { write_text(p, filament_sh_txt()); }});
+        return f;
     }
     void report(json_writer& j) const override;
 
 private:
+    /// Filament's cmgen SH text (--preset filament): one line "(r, g, b); // L{l}{m}" per
+    /// coefficient, the shader coefficients of E / pi for its Irradiance_SphericalHarmonics
+    /// polynomial (1, y, z, x, y x, y z, 3 z^2 - 1, z x, x^2 - y^2), i.e. sh.json's
+    /// irradiance_over_pi_shader(_windowed), in the mirrored frame the preset bakes.
+    std::string filament_sh_txt() const {
+        static const char* names[9] = {"L00", "L1-1", "L10", "L11", "L2-2", "L2-1", "L20", "L21", "L22"};
+        std::string t;
+        for (int k = 0; k < std::min(9, bands_ * bands_); ++k) {
+            char buf[160];
+            std::snprintf(buf, sizeof buf, "(%.9g, %.9g, %.9g); // %s\n", shader_[k].x, shader_[k].y, shader_[k].z, names[k]);
+            t += buf;
+        }
+        return t;
+    }
     template <int B> void project(const bake_context& ctx) {
         const ibl::cubemap<float>& src = ctx.source;
         const ibl::sh_coeffs<double, B> raw = ibl::project_cube<B>(
@@ -166,7 +183,7 @@ private:
 
     int bands_ = 3, texels_ = 0;
     std::string window_ = "auto";
-    bool windowed_ = false, sun_ = false;
+    bool windowed_ = false, sun_ = false, filament_ = false;
     double width_ = 0.0, ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     dvec3 min_before_{0.0}, min_after_{0.0};
     sh5 raw_{}, rad_{}, irr_{}, shader_{};

@@ -17,7 +17,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <cstdio>
 #include <iterator>
+#include <sstream>
 #include <map>
 #include <string>
 
@@ -82,6 +84,27 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     CHECK(kv["ibl.policy"].rfind("filament", 0) == 0);
     CHECK(kv["ibl.level_roughness"].find(' ') != std::string::npos);
     CHECK(kv.count("KTXwriter") == 1);
+    // Filament's SH text: 9 lines "(r, g, b); // L.." = sh.json's shader coefficients (E / pi)
+    {
+        const auto shj = ibl_examples::parse_json(slurp(s / "fil/sh.json"));
+        const ibl_examples::json_value* w = shj.find("irradiance_over_pi_shader_windowed");
+        const auto& k = (w ? *w : *shj.find("irradiance_over_pi_shader")).values;
+        std::istringstream txt(slurp(s / "fil/sh.txt"));
+        std::string line;
+        std::size_t n = 0;
+        while (std::getline(txt, line)) {
+            REQUIRE(n < k.size());
+            double r = 0, g = 0, b = 0;
+            char name[16] = {};
+            REQUIRE(std::sscanf(line.c_str(), "(%lf, %lf, %lf); // %15s", &r, &g, &b, name) == 4);
+            CHECK(r == doctest::Approx(k[n].values[0].number).epsilon(1e-8));
+            CHECK(g == doctest::Approx(k[n].values[1].number).epsilon(1e-8));
+            CHECK(b == doctest::Approx(k[n].values[2].number).epsilon(1e-8));
+            ++n;
+        }
+        CHECK(n == 9);
+        CHECK_FALSE(fs::exists(s / "gltf/sh.txt"));
+    }
     // gltf: linear chain, no mirror
     const auto gl = ibl_examples::parse_json(slurp(s / "gltf/report.json"));
     CHECK(gl.find("source")->find("brightest_direction")->values[0].number == doctest::Approx(br[0].number));
