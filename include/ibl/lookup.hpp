@@ -280,11 +280,13 @@ IBL_FUNC vec2<T> dfg_lut_coord(T n_dot_v, T roughness, std::uint32_t size, const
             dfg_sampler_coord(dfg_axis_coord(layout.roughness, roughness), size, layout.edge_aligned)};
 }
 
-/// Bilinear lookup with clamp-to-edge at sampler coordinates (s, t) of a table with members
-/// size, channels and data (dfg_lut): channels 0..2 (channel 2 is 0 for a two-channel table).
-template <class Table> vec3<float> dfg_sample_st(const Table& lut, float s, float t) {
+namespace detail {
+/// Bilinear read with clamp-to-edge at sampler coordinates (s, t) of a table with members size,
+/// channels and data (row-major, interleaved): channels 0 .. min(channels, count) - 1 into out
+/// (the others untouched). The one texel filter of every LUT lookup (DFG, sheen, lobe tables).
+template <class Table> void table_bilinear(const Table& lut, float s, float t, float* out, std::uint32_t count) {
     const std::uint32_t n = lut.size;
-    if (n == 0) return vec3<float>(0.0f);
+    if (n == 0) return;
     const float fx = clamp(s * float(n) - 0.5f, 0.0f, float(n - 1));
     const float fy = clamp(t * float(n) - 0.5f, 0.0f, float(n - 1));
     const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
@@ -294,13 +296,20 @@ template <class Table> vec3<float> dfg_sample_st(const Table& lut, float s, floa
     auto at = [&](std::uint32_t i, std::uint32_t j, std::uint32_t c) {
         return float(lut.data[(std::size_t(j) * n + i) * ch + c]);
     };
-    vec3<float> out(0.0f);
-    for (std::uint32_t c = 0; c < ch && c < 3; ++c) {
+    for (std::uint32_t c = 0; c < ch && c < count; ++c) {
         const float top = lerp(at(i0, j0, c), at(i1, j0, c), tx);
         const float bottom = lerp(at(i0, j1, c), at(i1, j1, c), tx);
-        out[int(c)] = lerp(top, bottom, ty);
+        out[c] = lerp(top, bottom, ty);
     }
-    return out;
+}
+} // namespace detail
+
+/// Bilinear lookup with clamp-to-edge at sampler coordinates (s, t) of a table with members
+/// size, channels and data (dfg_lut): channels 0..2 (channel 2 is 0 for a two-channel table).
+template <class Table> vec3<float> dfg_sample_st(const Table& lut, float s, float t) {
+    float v[3] = {0.0f, 0.0f, 0.0f};
+    detail::table_bilinear(lut, s, t, v, 3);
+    return vec3<float>(v[0], v[1], v[2]);
 }
 
 /// The DFG table of a layout at (n.v, r): (A, B, k) by one bilinear tap at dfg_lut_coord.

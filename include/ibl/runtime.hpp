@@ -222,22 +222,10 @@ inline vec3<float> specular_fis(const cubemap<float>& chain, const runtime_fis_d
 /// data (integrate/lobe_lut.hpp's lobe_lut) at the coordinates of a DFG layout (lookup.hpp).
 template <class Table>
 vec4<float> lobe_lut_lookup(const Table& lut, float n_dot_v, float roughness, const dfg_lut_layout& layout = {}) {
-    const std::uint32_t n = lut.size;
-    if (n == 0) return vec4<float>(0.0f);
-    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, n, layout);
-    const float fx = clamp(st.x * float(n) - 0.5f, 0.0f, float(n - 1));
-    const float fy = clamp(st.y * float(n) - 0.5f, 0.0f, float(n - 1));
-    const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
-    const std::uint32_t i1 = i0 + 1 < n ? i0 + 1 : i0, j1 = j0 + 1 < n ? j0 + 1 : j0;
-    const float tx = fx - float(i0), ty = fy - float(j0);
-    const std::uint32_t ch = lut.channels;
-    auto at = [&](std::uint32_t i, std::uint32_t j, std::uint32_t c) {
-        return float(lut.data[(std::size_t(j) * n + i) * ch + c]);
-    };
-    vec4<float> out(0.0f);
-    for (std::uint32_t c = 0; c < ch && c < 4; ++c)
-        out[int(c)] = lerp(lerp(at(i0, j0, c), at(i1, j0, c), tx), lerp(at(i0, j1, c), at(i1, j1, c), tx), ty);
-    return out;
+    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, layout);
+    float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
+    detail::table_bilinear(lut, st.x, st.y, v, 4);
+    return vec4<float>(v[0], v[1], v[2], v[3]);
 }
 
 /// The one-tap lobe model (header): LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) with
