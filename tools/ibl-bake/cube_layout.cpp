@@ -336,4 +336,32 @@ image_rgb32f octahedral_from_cube(const ibl::cubemap<float>& cube, int level, in
     return out;
 }
 
+cubemap_rgb32f cubemap_to_rgb32f(const ibl::cubemap<float>& c) {
+    cubemap_rgb32f k = cubemap_rgb32f::zeros(c.size(0), c.levels());
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < s; ++y)
+                for (int x = 0; x < s; ++x) {
+                    const ibl::vec3<float>& v = c.texel(f, x, y, l);
+                    float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+                    t[0] = v.x, t[1] = v.y, t[2] = v.z;
+                }
+    }
+    return k;
+}
+
+ibl::cubemap<float> cubemap_from_rgb32f(const cubemap_rgb32f& k) {
+    ibl::cubemap<float> c(k.size, int(k.levels.size()));
+    for (int l = 0; l < c.levels(); ++l) {
+        const int s = k.face_size(l);
+        c.fill(l, [&](int f, int x, int y) {
+            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
+            return ibl::vec3<float>(t[0], t[1], t[2]);
+        });
+    }
+    c.update_borders();
+    return c;
+}
+
 } // namespace ibl_bake

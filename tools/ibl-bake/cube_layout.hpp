@@ -141,6 +141,12 @@ cube_faces faces_from_cubemap(const ibl::cubemap<float>& cube, int level);
 /// faces, the others by generate_mips (exact box filter); borders valid, ready for lookups.
 ibl::cubemap<float> cubemap_from_faces(const cube_faces& faces, int levels = 0);
 
+/// Every level of a KTX2-layout cubemap (decode_ktx2_cubemap) as an ibl::cubemap<float> with its
+/// stored levels (not regenerated mips) and valid borders: what a renderer samples.
+ibl::cubemap<float> cubemap_from_rgb32f(const cubemap_rgb32f& cube);
+/// The inverse: every level of an ibl::cubemap<float> in the KTX2 writer's layout.
+cubemap_rgb32f cubemap_to_rgb32f(const ibl::cubemap<float>& cube);
+
 /// Lat-long image of a level (header comment). width 0 = 4 x face size of the level; otherwise
 /// width must be even and >= 2 (height = width / 2). Throws image_error for a bad width or level.
 image_rgb32f latlong_from_cube(const ibl::cubemap<float>& cube, int level, int width = 0);

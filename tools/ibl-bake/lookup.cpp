@@ -15,6 +15,7 @@
 
 #include <ibl/sh/convolve.hpp>
 
+#include "cube_layout.hpp"
 #include "json_value.hpp"
 #include "ktx2.hpp"
 
@@ -40,7 +41,7 @@ const json_value& member(const json_value& v, const char* key, const std::string
     return *m;
 }
 
-ibl::cubemap<float> cube_from_ktx2(const std::string& path) { return cube_from_ktx2_bytes(read_file(path), path); }
+ibl::cubemap<float> cube_from_ktx2(const std::string& path) { return cubemap_from_rgb32f(decode_ktx2_cubemap(read_file(path), path)); }
 
 ibl::dfg_lut lut_from_exr(const std::string& path, int channels) {
     const image_rgb32f img = read_image(path);

@@ -181,34 +181,7 @@ image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level) {
     return img;
 }
 
-cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& c) {
-    cubemap_rgb32f k = cubemap_rgb32f::zeros(c.size(0), c.levels());
-    for (int l = 0; l < c.levels(); ++l) {
-        const int s = k.face_size(l);
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < s; ++y)
-                for (int x = 0; x < s; ++x) {
-                    const fvec3& v = c.texel(f, x, y, l);
-                    float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
-                    t[0] = v.x, t[1] = v.y, t[2] = v.z;
-                }
-    }
-    return k;
-}
 
-ibl::cubemap<float> cube_from_ktx2_bytes(const std::vector<unsigned char>& bytes, const std::string& name) {
-    const cubemap_rgb32f k = decode_ktx2_cubemap(bytes, name);
-    ibl::cubemap<float> c(k.size, int(k.levels.size()));
-    for (int l = 0; l < c.levels(); ++l) {
-        const int s = k.face_size(l);
-        c.fill(l, [&](int f, int x, int y) {
-            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
-            return fvec3(t[0], t[1], t[2]);
-        });
-    }
-    c.update_borders();
-    return c;
-}
 
 void write_text(const std::string& path, const std::string& text) {
     write_file_atomic(path, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));

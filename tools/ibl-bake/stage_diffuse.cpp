@@ -17,6 +17,8 @@
 
 #include "stages.hpp"
 
+#include "cube_layout.hpp"
+
 #include <algorithm>
 #include <cmath>
 
@@ -303,7 +305,7 @@ public:
             f.push_back({std::string("irradiance_") + face_names[face] + ".exr",
                          [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0)); }});
         f.push_back({"irradiance.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, ktx_cube(*map_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_named(format_), "ibl-bake " + version_string());
                      }});
         return f;
     }

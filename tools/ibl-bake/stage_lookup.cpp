@@ -11,6 +11,8 @@
 
 #include "stages.hpp"
 
+#include "cube_layout.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
@@ -46,8 +48,8 @@ public:
         ibl::specular_lookup_desc chosen = specular_lookup_named(ctx.opt.specular_lookup);
         chosen.mapping = ctx.plan.specular.policy.mapping;
         const std::vector<unsigned char> bytes =
-            encode_ktx2_cubemap(ktx_cube(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
-        const ibl::cubemap<float> stored = cube_from_ktx2_bytes(bytes, "specular.ktx2");
+            encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
+        const ibl::cubemap<float> stored = cubemap_from_rgb32f(decode_ktx2_cubemap(bytes, "specular.ktx2"));
         const bool textbook = ctx.opt.specular_lookup == "textbook";
         ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "default" : "textbook");
         other.mapping = chosen.mapping;

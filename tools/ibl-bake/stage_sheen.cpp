@@ -14,6 +14,8 @@
 
 #include "stages.hpp"
 
+#include "cube_layout.hpp"
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -82,7 +84,7 @@ public:
                 f.push_back({"sheen_l" + std::to_string(l) + "_" + face_names[face] + ".exr",
                              [this, l, face](const std::string& p) { write_exr(p, face_image(chain_, face, l)); }});
         f.push_back({"sheen.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, ktx_cube(chain_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_named(format_), "ibl-bake " + version_string());
                      }});
         f.push_back({"sheen_lut.exr", [this](const std::string& p) {
                          image_rgb32f img(int(lut_.size), int(lut_.size));

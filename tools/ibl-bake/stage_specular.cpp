@@ -73,7 +73,7 @@ public:
         format_ = ctx.opt.ktx2_format;
         metadata_ = chain_metadata(ctx);
         layouts_ = ctx.opt.layouts;
-        quant_ = ktx2_quantisation_report(ktx_cube(*chain_), ktx2_format_named(format_));
+        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_named(format_));
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
         ctx.prog.begin("check specular");
         for (int k = 0; k < chain_->levels(); ++k) {
@@ -200,7 +200,7 @@ std::vector<file_out> specular_stage::files() const {
             f.push_back({base + "octahedral.exr", [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l)); }});
     }
     f.push_back({"specular.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, ktx_cube(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string(), metadata_);
+                     write_ktx2_cubemap(p, cubemap_to_rgb32f(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string(), metadata_);
                  }});
     return f;
 }

@@ -123,9 +123,8 @@ ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specul
 /// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
 
-/// Files: one face of a cube level as an RGB image; a cube as the KTX2 writer's input; text.
+/// Files: one face of a cube level as an RGB image; text (cube_layout.hpp converts cubes for the KTX2 writer).
 image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level);
-cubemap_rgb32f ktx_cube(const ibl::cubemap<float>& cube);
 void write_text(const std::string& path, const std::string& text);
 
 /// The KTX2 format named by --ktx2-format (rgba16f, rgba32f, b10g11r11, e5b9g9r9).
@@ -134,9 +133,6 @@ ktx2_format ktx2_format_named(const std::string& name);
 /// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.
 void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
-
-/// A KTX2 cubemap (any format ibl-bake writes) as an ibl::cubemap<float> with valid borders.
-ibl::cubemap<float> cube_from_ktx2_bytes(const std::vector<unsigned char>& bytes, const std::string& name);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
 void json_triples(json_writer& j, const sh5& c, int count);

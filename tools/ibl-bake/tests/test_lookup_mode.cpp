@@ -8,6 +8,7 @@
 
 #include <doctest/doctest.h>
 
+#include "cube_layout.hpp"
 #include "image_io.hpp"
 #include "tool_test_support.hpp"
 #include "json_value.hpp"
@@ -46,17 +47,8 @@ const std::string tool = IBL_BAKE_TOOL;
 
 ibl::cubemap<float> load_chain(const std::string& path) {
     const std::string b = slurp(path);
-    const cubemap_rgb32f k = decode_ktx2_cubemap(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(b.data()), b.size()));
-    ibl::cubemap<float> c(k.size, int(k.levels.size()));
-    for (int l = 0; l < c.levels(); ++l) {
-        const int s = k.face_size(l);
-        c.fill(l, [&](int f, int x, int y) {
-            const float* t = &k.levels[std::size_t(l)][std::size_t(f)][3 * (std::size_t(y) * std::size_t(s) + std::size_t(x))];
-            return fvec3(t[0], t[1], t[2]);
-        });
-    }
-    c.update_borders();
-    return c;
+    return cubemap_from_rgb32f(
+        decode_ktx2_cubemap(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(b.data()), b.size())));
 }
 
 ibl::dfg_lut load_lut(const std::string& path) {
@@ -91,6 +83,20 @@ std::vector<double> numbers(const std::string& line) {
 void check_close(const std::vector<double>& got, const std::vector<double>& want) {
     REQUIRE(got.size() == want.size());
     for (std::size_t i = 0; i < got.size(); ++i) CHECK(std::fabs(got[i] - want[i]) <= 2e-6 * std::fabs(want[i]) + 1e-12);
+}
+
+/// One answer line per expected row, each equal to it within check_close's tolerance.
+void check_answers(const std::string& text, const std::vector<std::vector<double>>& want) {
+    std::istringstream answers(text);
+    std::string line;
+    std::size_t n = 0;
+    while (std::getline(answers, line)) {
+        REQUIRE(n < want.size());
+        INFO("answer " << n + 1 << ": " << line);
+        check_close(numbers(line), want[n]);
+        ++n;
+    }
+    CHECK(n == want.size());
 }
 
 } // namespace
@@ -149,16 +155,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         return all;
     }();
     REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "queries.txt") + " > " + (s / "answers.txt")) == 0);
-    std::istringstream answers(slurp(s / "answers.txt"));
-    std::string line;
-    std::size_t n = 0;
-    while (std::getline(answers, line)) {
-        REQUIRE(n < want.size());
-        INFO(q[n]);
-        check_close(numbers(line), want[n]);
-        ++n;
-    }
-    CHECK(n == want.size());
+    check_answers(slurp(s / "answers.txt"), want);
 
     std::ofstream(s / "bad.txt") << "specular 0 1 0\nfoo 1 2\ndfg 0.5 x\nirradiance 0 0 0\ndfg 0.5 0.5\n";
     CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "bad.txt") + " > " + (s / "bad_answers.txt")) == 1);
@@ -200,15 +197,7 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
         }
     std::ofstream(s / "q.txt") << q;
     REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
-    std::istringstream answers(slurp(s / "a.txt"));
-    std::string line;
-    std::size_t n = 0;
-    while (std::getline(answers, line)) {
-        REQUIRE(n < want.size());
-        check_close(numbers(line), want[n]);
-        ++n;
-    }
-    CHECK(n == want.size());
+    check_answers(slurp(s / "a.txt"), want);
 }
 
 TEST_CASE("lookup: sheen and dfg_sheen answer from the sheen chain and table") {
@@ -234,15 +223,7 @@ TEST_CASE("lookup: sheen and dfg_sheen answer from the sheen chain and table") {
     }
     std::ofstream(s / "q.txt") << q;
     REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
-    std::istringstream answers(slurp(s / "a.txt"));
-    std::string line;
-    std::size_t n = 0;
-    while (std::getline(answers, line)) {
-        REQUIRE(n < want.size());
-        check_close(numbers(line), want[n]);
-        ++n;
-    }
-    CHECK(n == want.size());
+    check_answers(slurp(s / "a.txt"), want);
     // a bake without --sheen says so
     REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --out " + (s / "plain") + " >/dev/null 2>&1") == 0);
     std::ofstream(s / "q2.txt") << "sheen 0 1 0 0.5\n";
