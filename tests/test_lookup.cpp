@@ -257,3 +257,17 @@ TEST_CASE("specular interpolation error on a smooth environment matches its clos
         }
     }
 }
+
+TEST_CASE("lookup_error: the lobe-generic texel-sum LD equals the GGX one for ggx_lobe") {
+    ibl::cubemap<float> c(8);
+    c.fill(0, [](int f, int x, int y) { return ibl::vec3<float>(0.1f + 0.2f * f, 0.05f * x + 0.3f, 0.07f * y + 0.1f); });
+    c.generate_mips();
+    std::vector<ibl::vec3<double>> dirs;
+    for (int f = 0; f < 6; ++f) dirs.push_back(ibl::cube_texel_direction<double>(f, 3, 4, 8));
+    for (const double r : {0.2, 0.5, 1.0}) {
+        const auto a = ibl::reference_ld_texel_sum(c, 0, std::span<const ibl::vec3<double>>(dirs), r);
+        const auto b = ibl::reference_ld_texel_sum_lobe<ibl::ggx_lobe>(c, 0, std::span<const ibl::vec3<double>>(dirs), r);
+        for (std::size_t i = 0; i < dirs.size(); ++i)
+            for (int k = 0; k < 3; ++k) CHECK(b[i][k] == doctest::Approx(a[i][k]).epsilon(1e-12));
+    }
+}

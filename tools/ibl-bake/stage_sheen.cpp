@@ -22,6 +22,7 @@
 #include <limits>
 
 #include <ibl/env/cube_geometry.hpp>
+#include <ibl/integrate/lookup_error.hpp>
 #include <ibl/integrate/metrics.hpp>
 #include <ibl/integrate/reference.hpp>
 #include <ibl/brdf/charlie.hpp>
@@ -97,46 +98,21 @@ public:
     void report(json_writer& j) const override;
 
 private:
-    /// Level l against the exact Charlie LD of the source cube: the sum over every texel t of its
-    /// first level of face <= 64 of L_t D(h_t) (n.l_t) Omega_t / sum D (n.l) Omega (n = v = R; the
-    /// lobe's n.l > 0 half, as the prefilter's). A sampled reference does not converge on a sun.
+    /// Level l plus the sun's term against the exact Charlie LD of the source before extraction
+    /// (ibl::reference_ld_texel_sum_lobe over its first level of face <= 64; a sampled reference
+    /// does not converge on a sun).
     ibl::error_metrics check_level(const bake_context& ctx, int l) const {
         const int n = chain_.size(l);
         const double r = ibl::roughness_mip_policy::linear().roughness(double(l), chain_.levels());
-        const double alpha = ibl::charlie_lobe::alpha(r);
         const ibl::cubemap<float>& src = ctx.whole_source(); // the whole environment: the runtime adds the sun
-        const int sl = level_at_most(src, 64), m = src.size(sl);
-        std::vector<dvec3> td, tl;
-        std::vector<double> tw;
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < m; ++y)
-                for (int x = 0; x < m; ++x) {
-                    td.push_back(ibl::cube_texel_direction<double>(f, x, y, m));
-                    tl.push_back(dvec3(src.texel(f, x, y, sl)));
-                    tw.push_back(ibl::cube_texel_solid_angle<double>(x, y, m));
-                }
         const std::vector<std::array<int, 3>> tex = check_texels(n, ctx.qs.ref_grid, ctx.light);
-        std::vector<dvec3> ref(tex.size());
-        ctx.ex(tex.size(), [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-                const dvec3 R = ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n);
-                dvec3 sum(0.0);
-                double w = 0.0;
-                for (std::size_t t = 0; t < td.size(); ++t) {
-                    const double c = glm::dot(R, td[t]);
-                    if (!(c > 0.0)) continue;
-                    const double wt = ibl::ndf_charlie(std::sqrt(0.5 * (1.0 + c)), alpha) * c * tw[t];
-                    sum += wt * tl[t];
-                    w += wt;
-                }
-                ref[i] = w > 0.0 ? sum / w : dvec3(0.0);
-            }
-        });
+        std::vector<dvec3> dirs;
+        for (const auto& t : tex) dirs.push_back(ibl::cube_texel_direction<double>(t[0], t[1], t[2], n));
+        const std::vector<dvec3> ref = ibl::reference_ld_texel_sum_lobe<ibl::charlie_lobe>(
+            src, level_at_most(src, 64), std::span<const dvec3>(dirs), r, ctx.ex);
         ibl::error_accumulator acc(1e-3 * std::max(ctx.lstats.mean, 1e-30));
-        for (std::size_t i = 0; i < tex.size(); ++i) {
-            const dvec3 R = ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n);
-            acc.add(dvec3(chain_.texel(tex[i][0], tex[i][1], tex[i][2], l)) + sheen_sun_ld(sun_, R, r), ref[i]);
-        }
+        for (std::size_t i = 0; i < tex.size(); ++i)
+            acc.add(dvec3(chain_.texel(tex[i][0], tex[i][1], tex[i][2], l)) + sheen_sun_ld(sun_, dirs[i], r), ref[i]);
         return acc.finish();
     }
     void check_lut(pool_executor& ex) {

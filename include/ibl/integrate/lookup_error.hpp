@@ -65,6 +65,7 @@
 #include "../env/cube_geometry.hpp"
 #include "../env/cubemap.hpp"
 #include "../lookup.hpp"
+#include "../sampling/lobe.hpp"
 #include "dfg.hpp"
 #include "dfg_lut.hpp"
 #include "metrics.hpp"
@@ -273,25 +274,39 @@ template <class T> int reference_ld_texel_level(const cubemap<T>& c, double roug
     return level;
 }
 
-/// Exact LD of cubemap level `level` at each direction (texel-sum quadrature, see the header).
-/// Non-finite texel components read as 0. Work items: directions.
-template <class T, class Executor = serial_executor>
-std::vector<vec3<double>> reference_ld_texel_sum(const cubemap<T>& c, int level, std::span<const vec3<double>> dirs,
-                                                 double roughness, Executor&& ex = Executor{}) {
+namespace detail {
+/// Every texel of one cubemap level: centre direction, radiance (non-finite components as 0),
+/// exact solid angle.
+struct level_texels {
+    std::vector<vec3<double>> dir, radiance;
+    std::vector<double> solid_angle;
+};
+template <class T> level_texels gather_level_texels(const cubemap<T>& c, int level) {
     const int n = c.size(level);
-    std::vector<vec3<double>> td, tl;
-    std::vector<double> tw;
-    td.reserve(std::size_t(6) * std::size_t(n) * std::size_t(n));
+    level_texels t;
+    t.dir.reserve(std::size_t(6) * std::size_t(n) * std::size_t(n));
     for (int f = 0; f < 6; ++f)
         for (int y = 0; y < n; ++y)
             for (int x = 0; x < n; ++x) {
                 vec3<double> L(c.texel(f, x, y, level));
                 for (int k = 0; k < 3; ++k)
                     if (!std::isfinite(L[k])) L[k] = 0.0;
-                td.push_back(cube_texel_direction<double>(f, x, y, n));
-                tl.push_back(L);
-                tw.push_back(cube_texel_solid_angle<double>(x, y, n));
+                t.dir.push_back(cube_texel_direction<double>(f, x, y, n));
+                t.radiance.push_back(L);
+                t.solid_angle.push_back(cube_texel_solid_angle<double>(x, y, n));
             }
+    return t;
+}
+} // namespace detail
+
+/// Exact LD of cubemap level `level` at each direction (texel-sum quadrature, see the header).
+/// Non-finite texel components read as 0. Work items: directions.
+template <class T, class Executor = serial_executor>
+std::vector<vec3<double>> reference_ld_texel_sum(const cubemap<T>& c, int level, std::span<const vec3<double>> dirs,
+                                                 double roughness, Executor&& ex = Executor{}) {
+    const detail::level_texels tex = detail::gather_level_texels(c, level);
+    const std::vector<vec3<double>>&td = tex.dir, &tl = tex.radiance;
+    const std::vector<double>& tw = tex.solid_angle;
     const double a2 = sqr(clamp_alpha(alpha_from_roughness(roughness)));
     std::vector<vec3<double>> out(dirs.size());
     ex(dirs.size(), [&](std::size_t b, std::size_t e) {
@@ -306,6 +321,38 @@ std::vector<vec3<double>> reference_ld_texel_sum(const cubemap<T>& c, int level,
                 const double den = nh2 * (a2 - 1.0) + 1.0;
                 const double wt = tw[t] * cl * a2 / (pi_v<double> * den * den);
                 s += wt * tl[t];
+                w += wt;
+            }
+            out[i] = w > 0.0 ? s / w : vec3<double>(0.0);
+        }
+    });
+    return out;
+}
+
+/// The texel-sum LD of any lobe L (sampling/lobe.hpp) at each direction: sum_t L_t w_t / sum_t w_t
+/// with w_t = Omega_t (n.l_t) D(h_t) (n.h_t) / (n.h_t), D (n.h) taken as L::pdf x L::ld_weight (the
+/// lobe's contract: equal up to a factor of r alone, which cancels), h_t the half vector of R and
+/// the texel direction (n = v = R); only n.l > 0 counts, as in the prefilter. Isotropic lobes (the
+/// lobe functions are evaluated at h = (sin theta_h, 0, cos theta_h)). For GGX it is
+/// reference_ld_texel_sum up to rounding; reference_ld_texel_level picks a fine enough level.
+template <class Lobe, class T, class Executor = serial_executor>
+    requires ld_lobe<Lobe>
+std::vector<vec3<double>> reference_ld_texel_sum_lobe(const cubemap<T>& c, int level, std::span<const vec3<double>> dirs,
+                                                      double roughness, Executor&& ex = Executor{}) {
+    const detail::level_texels tex = detail::gather_level_texels(c, level);
+    std::vector<vec3<double>> out(dirs.size());
+    ex(dirs.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) {
+            const vec3<double> R = glm::normalize(dirs[i]);
+            vec3<double> s(0.0);
+            double w = 0.0;
+            for (std::size_t t = 0; t < tex.dir.size(); ++t) {
+                const double cl = glm::dot(R, tex.dir[t]);
+                if (!(cl > 0.0)) continue;
+                const double ch = std::sqrt(0.5 * (1.0 + cl)), sh = std::sqrt(0.5 * (1.0 - cl));
+                const vec3<double> h(sh, 0.0, ch);
+                const double wt = tex.solid_angle[t] * cl * Lobe::pdf(h, roughness) * Lobe::ld_weight(h, roughness) / ch;
+                s += wt * tex.radiance[t];
                 w += wt;
             }
             out[i] = w > 0.0 ? s / w : vec3<double>(0.0);
