@@ -9,7 +9,11 @@
 //       taps     = chain textureLod reads per evaluation (the LUT tap comes on top where used).
 //     variants: 0 split sum (n.l chain), 1 split sum (G1 chain), 2 Frostbite dominant direction
 //     (n.l chain), 3 lobe LUT (G1 chain), 4 FIS 8 taps, 5 FIS 16 taps, 6 FIS 64 taps (normalised,
-//     G1 chain).
+//     G1 chain), 7 fitted lobe LUT (one tap, L1 fit; integrate/lobe_fit.hpp), 8 fitted 2 taps,
+//     9 fitted 3 taps (G1 chain; 32^2 tables).
+//   BM_lobe_fit_table/<taps>: building the fitted table (make_lobe_taps_lut) of 1 tap (default fit
+//     options, what make_lobe_lut_fitted runs), 2 or 3 taps (make_lobe_taps_lut, 32 nodes, 150 iterations) at 32^2, 2 threads;
+//     counter mean_l1 = the fits' mean L1 distance to the lobe.
 // Run: ./build/release/bench/bench_runtime --benchmark_min_time=0.1
 #include <benchmark/benchmark.h>
 
@@ -17,6 +21,7 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/integrate/env_importance.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/integrate/lookup_error.hpp>
 #include <ibl/integrate/prefilter.hpp>
@@ -42,7 +47,8 @@ struct point {
 struct fixture {
     ibl::cubemap<float> chain_nl{1}, chain_g1{1};
     ibl::dfg_lut dfg;
-    ibl::lobe_lut lobe;
+    ibl::lobe_lut lobe, lobe_fitted;
+    ibl::lobe_taps_lut taps2, taps3;
     std::vector<point> points;
 };
 
@@ -67,6 +73,14 @@ ibl::cubemap<float> chain(const ibl::cubemap<float>& src, ibl::ld_weight w) {
     return ibl::prefilter(src, o, ibl::thread_executor{});
 }
 
+ibl::lobe_fit_options multi_tap_options(int taps) {
+    ibl::lobe_fit_options o;
+    o.taps = taps;
+    o.nodes = 32;
+    o.iterations = 150;
+    return o;
+}
+
 const fixture& fix() {
     static const fixture f = [] {
         fixture x;
@@ -76,6 +90,9 @@ const fixture& fix() {
         x.chain_g1 = chain(src, ibl::ld_weight::g1);
         x.dfg = ibl::make_dfg_lut_exact<model>(128, ibl::dfg_lut_layout{}, 2);
         x.lobe = ibl::make_lobe_lut<model>(64, ibl::dfg_lut_layout{}, ibl::ld_weight::g1);
+        x.lobe_fitted = ibl::make_lobe_lut_fitted<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1);
+        x.taps2 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, multi_tap_options(2));
+        x.taps3 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, multi_tap_options(3));
         const ibl::cube_env_distribution dist = ibl::make_cube_env_distribution<double>(sky, 64, 4);
         std::uint32_t k = 0;
         for (double r : {0.3, 0.5, 0.8})
@@ -117,6 +134,13 @@ f3 evaluate(int variant, const fixture& f, const point& p) {
     case 3:
         return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc{}, f.lobe, ibl::dfg_lut_layout{}, p.n, p.v,
                                   p.roughness, k_f0, f3(1.0f));
+    case 7:
+        return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc{}, f.lobe_fitted, ibl::dfg_lut_layout{}, p.n, p.v,
+                                  p.roughness, k_f0, f3(1.0f));
+    case 8:
+    case 9:
+        return ibl::specular_lobe_taps(f.chain_g1, ibl::specular_lookup_desc{}, variant == 8 ? f.taps2 : f.taps3,
+                                       ibl::dfg_lut_layout{}, p.n, p.v, p.roughness, k_f0, f3(1.0f));
     default: {
         ibl::runtime_fis_desc d;
         d.taps = variant == 4 ? 8 : (variant == 5 ? 16 : 64);
@@ -140,9 +164,23 @@ void BM_runtime_specular(benchmark::State& state) {
     }
     state.SetItemsProcessed(state.iterations());
     state.counters["rel_rmse"] = std::sqrt(sq / double(f.points.size()));
-    const double taps[] = {2, 2, 2, 2, 8, 16, 64};
+    const double taps[] = {2, 2, 2, 2, 8, 16, 64, 2, 4, 6};
     state.counters["taps"] = taps[variant];
 }
-BENCHMARK(BM_runtime_specular)->DenseRange(0, 6);
+BENCHMARK(BM_runtime_specular)->DenseRange(0, 9);
+
+void BM_lobe_fit_table(benchmark::State& state) {
+    const int taps = int(state.range(0));
+    const ibl::lobe_fit_options o = taps == 1 ? ibl::lobe_fit_options{} : multi_tap_options(taps);
+    double l1 = 0.0;
+    for (auto _ : state) {
+        const ibl::lobe_taps_lut l = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, o,
+                                                                    ibl::thread_executor{2});
+        benchmark::DoNotOptimize(l.data.data());
+        l1 = l.mean_l1;
+    }
+    state.counters["mean_l1"] = l1;
+}
+BENCHMARK(BM_lobe_fit_table)->DenseRange(1, 3)->Unit(benchmark::kMillisecond)->Iterations(1);
 
 } // namespace

@@ -3,7 +3,10 @@
 // the environment, no split sum), over random normals and views at fixed n.v. The tables of
 // docs/runtime.md come from here.
 //
-//   runtime_error [quick]      quick: 8 points per cell, 2^13 reference samples (a smoke run)
+//   runtime_error [quick|explore|fit] [levels=N]
+//     quick: 8 points per cell, 2^13 reference samples (a smoke run); explore: FIS footprint
+//     scales; fit: the per-cell L1 fits of 1, 2, 3 and 6 taps (integrate/lobe_fit.hpp, no table)
+//     against their 32^2 tables; levels=N: a chain of N levels (default 6, as ibl-bake).
 //
 // Environments: the built-in sky + sun (ibl::make_default_sky; integrand analytic) and
 // tests/data/{courtyard,studio}.exr (integrand the lat-long map). Each is baked to a 512^2 source
@@ -25,6 +28,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <functional>
 #include <string>
@@ -38,6 +42,7 @@
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
 #include <ibl/integrate/env_importance.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/integrate/lookup_error.hpp>
 #include <ibl/integrate/prefilter.hpp>
@@ -74,6 +79,10 @@ struct products {
     const ibl::dfg_lut* dfg = nullptr;
     const ibl::lobe_lut* lobe_nl = nullptr;
     const ibl::lobe_lut* lobe_g1 = nullptr;
+    const ibl::lobe_lut* lobe_fit_g1 = nullptr;
+    const ibl::lobe_lut* lobe_fit_nl = nullptr;
+    const ibl::lobe_taps_lut* taps2_g1 = nullptr;
+    const ibl::lobe_taps_lut* taps3_g1 = nullptr;
 };
 
 struct shading_point {
@@ -113,6 +122,81 @@ f3 fis(const ibl::cubemap<float>& chain, const products& p, const shading_point&
     return ibl::specular_fis(chain, d, s.n, s.v, s.roughness, s.f0, f3(1.0f), ibl::vec2<float>(abk.x, abk.y));
 }
 
+/// Fitted mixtures per (r, n.v) cell and tap count (index [count - 1][r][mu]).
+struct fitted_cells {
+    std::vector<ibl::lobe_mixture> m[6];
+    const ibl::lobe_mixture& at(int count, const shading_point& s) const {
+        int ir = 0, im = 0;
+        for (int i = 0; i < n_r; ++i)
+            if (std::fabs(float(k_roughness[i]) - s.roughness) < 1e-6f) ir = i;
+        for (int i = 0; i < n_mu; ++i)
+            if (std::fabs(float(k_n_dot_v[i]) - s.n_dot_v) < 1e-6f) im = i;
+        return m[count - 1][std::size_t(ir * n_mu + im)];
+    }
+};
+fitted_cells g_fits;
+
+void make_fits(ibl::ld_weight w) {
+    for (int c : {1, 2, 3, 6}) {
+        g_fits.m[c - 1].assign(std::size_t(n_r * n_mu), {});
+        ibl::thread_executor{2}(std::size_t(n_r * n_mu), [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+                ibl::lobe_fit_options o;
+                o.taps = c;
+                o.nodes = 32;
+                o.iterations = 150;
+                g_fits.m[c - 1][i] = ibl::fit_specular_lobe<model>(k_n_dot_v[i % n_mu], k_roughness[i / n_mu], w, o);
+            }
+        });
+    }
+}
+
+f3 mixture(const ibl::cubemap<float>& chain, const products& p, const shading_point& s, int count) {
+    const ibl::lobe_mixture& mx = g_fits.at(count, s);
+    const f3 r_dir = reflect_dir(s);
+    f3 t = r_dir - glm::dot(s.n, r_dir) * s.n;
+    const float tl = glm::length(t);
+    t = tl > 1e-6f ? t / tl : ibl::make_frame(s.n).t;
+    f3 sum(0.0f);
+    for (int k = 0; k < mx.count; ++k) {
+        const auto& tp = mx.taps[std::size_t(k)];
+        const f3 d = float(std::cos(tp.angle)) * s.n + float(std::sin(tp.angle)) * t;
+        sum += float(tp.weight) * ibl::specular_lookup(chain, d, float(tp.roughness), k_lookup);
+    }
+    return sum * albedo_of(p, s);
+}
+
+std::vector<variant> make_fit_variants() {
+    std::vector<variant> v;
+    v.push_back({"split sum, G1 chain", "2 + 1", [](const products& p, const shading_point& s) {
+                     return split(p.chain_g1, p, s, reflect_dir(s));
+                 }});
+    v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                               f3(1.0f));
+                 }});
+    v.push_back({"fitted lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                               f3(1.0f));
+                 }});
+    v.push_back({"fitted 2 taps LUT, G1", "4 + 2", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps2_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                                    f3(1.0f));
+                 }});
+    v.push_back({"fitted 3 taps LUT, G1", "6 + 3", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                                    f3(1.0f));
+                 }});
+    v.push_back({"L1 fit 1 tap, G1", "2 + 1", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 1); }});
+    v.push_back({"L1 fit 2 taps, G1", "4 + 2", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 2); }});
+    v.push_back({"L1 fit 3 taps, G1", "6 + 3", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 3); }});
+    v.push_back({"L1 fit 6 taps, G1", "12 + 5", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 6); }});
+    v.push_back({"FIS 16, normalised, G1", "16 + 1", [](const products& p, const shading_point& s) {
+                     return fis(p.chain_g1, p, s, 16, 1.0f, true);
+                 }});
+    return v;
+}
+
 std::vector<variant> make_variants(bool explore) {
     std::vector<variant> v;
     v.push_back({"split sum, n.l chain", "2 + 1", [](const products& p, const shading_point& s) {
@@ -136,6 +220,22 @@ std::vector<variant> make_variants(bool explore) {
     v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
                      return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
+                 }});
+    v.push_back({"fitted lobe LUT, n.l", "2 + 1", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_fit_nl, k_layout, s.n, s.v, s.roughness, s.f0,
+                                               f3(1.0f));
+                 }});
+    v.push_back({"fitted lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                               f3(1.0f));
+                 }});
+    v.push_back({"fitted 2 taps LUT, G1", "4 + 2", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps2_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                                    f3(1.0f));
+                 }});
+    v.push_back({"fitted 3 taps LUT, G1", "6 + 3", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                                    f3(1.0f));
                  }});
     v.push_back({"FIS 4, normalised, G1", "4 + 1", [](const products& p, const shading_point& s) {
                      return fis(p.chain_g1, p, s, 4, 1.0f, true);
@@ -272,12 +372,14 @@ std::vector<std::uint32_t> tool_samples(int levels) {
     return s;
 }
 
+int g_levels = 6; ///< chain levels (levels=N on the command line)
+
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, ibl::ld_weight w) {
     ibl::prefilter_options o;
-    o.levels = 6;
+    o.levels = g_levels;
     o.base_size = 256;
     o.trilinear = true;
-    o.samples_per_level = tool_samples(6);
+    o.samples_per_level = tool_samples(g_levels);
     o.weight = w;
     return ibl::prefilter(src, o, ibl::thread_executor{2});
 }
@@ -331,6 +433,10 @@ void print_detail(const env_result& e, const std::vector<variant>& vars, std::si
 int main(int argc, char** argv) {
     const bool quick = argc > 1 && std::strcmp(argv[1], "quick") == 0;
     const bool explore = argc > 1 && std::strcmp(argv[1], "explore") == 0;
+    const bool fit_mode = argc > 1 && std::strcmp(argv[1], "fit") == 0;
+    for (int a = 1; a < argc; ++a)
+        if (std::strncmp(argv[a], "levels=", 7) == 0) g_levels = std::clamp(std::atoi(argv[a] + 7), 2, 9);
+    std::printf("chain: 256^2, %d levels, linear roughness l / %d\n", g_levels, g_levels - 1);
     const std::uint32_t points = quick || explore ? 8 : 64;
     const std::uint32_t ref_samples = quick || explore ? 1u << 13 : 1u << 15;
     const auto t0 = std::chrono::steady_clock::now();
@@ -343,7 +449,24 @@ int main(int argc, char** argv) {
     const ibl::lobe_lut lobe_nl = ibl::make_lobe_lut<model>(64, k_layout, ibl::ld_weight::n_dot_l, 96, ibl::thread_executor{2});
     const ibl::lobe_lut lobe_g1 = ibl::make_lobe_lut<model>(64, k_layout, ibl::ld_weight::g1, 96, ibl::thread_executor{2});
     std::printf("tables: DFG 128^2, lobe LUTs 64^2 (n.l, G1): %.1f s\n", seconds_since(t0));
-    const std::vector<variant> vars = make_variants(explore);
+    if (fit_mode) make_fits(ibl::ld_weight::g1);
+    std::printf("fits: %.1f s\n", seconds_since(t0));
+    ibl::lobe_fit_options fo;
+    const auto tf = std::chrono::steady_clock::now();
+    const ibl::lobe_lut lobe_fit_g1 = ibl::make_lobe_lut_fitted<model>(32, k_layout, ibl::ld_weight::g1, fo, ibl::thread_executor{2});
+    const ibl::lobe_lut lobe_fit_nl = ibl::make_lobe_lut_fitted<model>(32, k_layout, ibl::ld_weight::n_dot_l, fo, ibl::thread_executor{2});
+    std::printf("fitted lobe LUTs 32^2 (G1, n.l): %.1f s\n", seconds_since(tf));
+    fo.taps = 2;
+    fo.nodes = 32; // the multi-tap tables: finer fits (16 nodes and 40 iterations lose 3.5% pooled)
+    fo.iterations = 150;
+    const auto tf2 = std::chrono::steady_clock::now();
+    const ibl::lobe_taps_lut taps2_g1 = ibl::make_lobe_taps_lut<model>(32, k_layout, ibl::ld_weight::g1, fo, ibl::thread_executor{2});
+    std::printf("fitted 2-tap LUT 32^2: %.1f s, L1 max %.3f mean %.3f\n", seconds_since(tf2), taps2_g1.max_l1, taps2_g1.mean_l1);
+    fo.taps = 3;
+    const auto tf3 = std::chrono::steady_clock::now();
+    const ibl::lobe_taps_lut taps3_g1 = ibl::make_lobe_taps_lut<model>(32, k_layout, ibl::ld_weight::g1, fo, ibl::thread_executor{2});
+    std::printf("fitted 3-tap LUT 32^2: %.1f s, L1 max %.3f mean %.3f\n", seconds_since(tf3), taps3_g1.max_l1, taps3_g1.mean_l1);
+    const std::vector<variant> vars = fit_mode ? make_fit_variants() : make_variants(explore);
 
     std::vector<env_result> results;
     auto run = [&](const std::string& name, const auto& integrand, const ibl::cubemap<float>& src,
@@ -355,6 +478,10 @@ int main(int argc, char** argv) {
         p.dfg = &dfg;
         p.lobe_nl = &lobe_nl;
         p.lobe_g1 = &lobe_g1;
+        p.lobe_fit_g1 = &lobe_fit_g1;
+        p.lobe_fit_nl = &lobe_fit_nl;
+        p.taps2_g1 = &taps2_g1;
+        p.taps3_g1 = &taps3_g1;
         std::printf("%s: chains baked %.1f s\n", name.c_str(), seconds_since(t1));
         results.push_back({name, measure(integrand, dist, p, vars, points, ref_samples)});
         std::printf("%s: measured %.1f s\n", name.c_str(), seconds_since(t1));
@@ -418,7 +545,8 @@ int main(int argc, char** argv) {
                     cnt > 0 ? 100.0 * std::sqrt(npooled / cnt) : 0.0);
     }
     for (const env_result& e : results)
-        for (const std::size_t q : {std::size_t(0), std::size_t(3), std::size_t(5), std::size_t(8)}) print_detail(e, vars, q, 0);
+        for (const std::size_t q : {std::size_t(0), std::size_t(3), std::size_t(5), std::size_t(8)})
+            if (q < vars.size()) print_detail(e, vars, q, 0);
     std::printf("\ntotal time %.1f s\n", seconds_since(t0));
     return 0;
 }

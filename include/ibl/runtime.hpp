@@ -241,6 +241,48 @@ vec3<float> specular_lobe(const cubemap<float>& chain, const specular_lookup_des
     return specular_lookup(chain, d, p.w, sd) * split_sum_albedo(f0, f90, vec2<float>(p.x, p.y));
 }
 
+// ---- fitted taps ----------------------------------------------------------------------------------
+
+/// The unit tangent of n in the plane of incidence, towards R (header); any tangent of n when
+/// R is (nearly) n.
+template <class T> IBL_FUNC vec3<T> incidence_tangent(const vec3<T>& n, const vec3<T>& r_dir) noexcept {
+    using std::sqrt;
+    const vec3<T> t = r_dir - glm::dot(n, r_dir) * n;
+    const T len2 = glm::dot(t, t);
+    return len2 > T(1e-12) ? t * (T(1) / sqrt(len2)) : make_frame(n).t;
+}
+
+/// The fitted-taps model (integrate/lobe_fit.hpp) from a table with members size, channels, taps
+/// and data (lobe_taps_lut, continuous taps): at (n.v, r) one bilinear read of the channels
+/// (A, B, then angle / (pi/2), roughness, weight per tap), then
+///     Lo_s ~ (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k)
+/// with t = incidence_tangent(n, R) and each LD by the chain lookup sd. Cost: taps chain lookups
+/// and ceil((2 + 3 taps) / 4) RGBA table reads.
+template <class Table>
+vec3<float> specular_lobe_taps(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
+                               const dfg_lut_layout& layout, const vec3<float>& n, const vec3<float>& v, float roughness,
+                               const vec3<float>& f0, const vec3<float>& f90) {
+    constexpr std::uint32_t max_channels = 2 + 3 * 8;
+    const float n_dot_v = saturate(glm::dot(n, v));
+    const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
+    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, layout);
+    float p[max_channels] = {};
+    detail::table_bilinear(lut, st.x, st.y, p, lut.channels < max_channels ? lut.channels : max_channels);
+    const vec3<float> t = incidence_tangent(n, r_dir);
+    const int taps = int((std::min(lut.channels, max_channels) - 2) / 3);
+    vec3<float> sum(0.0f);
+    float wsum = 0.0f;
+    for (int k = 0; k < taps; ++k) {
+        const float a = p[2 + 3 * k] * half_pi_v<float>, w = p[4 + 3 * k];
+        if (!(w > 0.0f)) continue;
+        const vec3<float> d = glm::normalize(std::cos(a) * n + std::sin(a) * t);
+        sum += w * specular_lookup(chain, d, p[3 + 3 * k], sd);
+        wsum += w;
+    }
+    const vec3<float> ld = wsum > 0.0f ? sum / wsum : specular_lookup(chain, r_dir, roughness, sd);
+    return ld * split_sum_albedo(f0, f90, vec2<float>(p[0], p[1]));
+}
+
 } // namespace ibl
 
 #endif // IBL_DETAIL_CXX20

@@ -1,0 +1,208 @@
+// tests/test_lobe_fit.cpp — the lobe fit (integrate/lobe_fit.hpp) and the fitted-taps runtime
+// (runtime.hpp): the chain kernel's normaliser and density against an independent quadrature in
+// the polar angle, the L1 estimator over the lobe's draws against a direct quadrature of |p - q|
+// over the whole sphere (p from the model's D and V, normalised by dfg_exact), the fit's exact
+// answer at n.v = 1 for a G1 chain (the lobe is the kernel there), the fit against the moment match
+// and against fewer taps at grazing views, the tables (A, B equal to the DFG table, weights
+// summing to 1, the mirror row) and the white furnace of both runtime models.
+//
+// Tolerances: a quadrature's own error is bounded by the change when its resolution doubles
+// (smooth integrands, midpoint rules of order 2: the finer result's error is about a third of that
+// change, so 1x the change is a safe bound); float storage and arithmetic by multiples of the
+// float epsilon.
+
+#include <doctest/doctest.h>
+
+#include <ibl/brdf/model.hpp>
+#include <ibl/integrate/dfg.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
+#include <ibl/runtime.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace {
+
+using d3 = ibl::vec3<double>;
+using f3 = ibl::vec3<float>;
+using model = ibl::ggx_height_correlated;
+constexpr double feps = std::numeric_limits<float>::epsilon();
+constexpr double pi = ibl::pi_v<double>;
+
+/// W(r') = (pi / 2) int_0^{pi/2} D(cos(theta / 2)) w(cos theta) sin(theta) d theta, m midpoint nodes;
+/// with density = true: int K(mu) dl over the sphere from ld_kernel_value (should be 1).
+double polar_kernel_integral(double r, ibl::ld_weight w, int m, bool density) {
+    const double alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(r));
+    const double norm = ibl::ld_kernel_normaliser(r, w, 4096);
+    double s = 0.0;
+    for (int i = 0; i < m; ++i) {
+        const double t = (i + 0.5) * ibl::half_pi_v<double> / m, mu = std::cos(t);
+        if (density) s += ibl::ld_kernel_value(mu, alpha, norm, w) * 2.0 * pi * std::sin(t);
+        else s += 0.5 * pi * ibl::ndf_ggx(std::cos(0.5 * t), alpha) * (w == ibl::ld_weight::g1 ? ibl::g1_smith_ggx(mu, alpha) : mu) *
+                  std::sin(t);
+    }
+    return s * ibl::half_pi_v<double> / m;
+}
+
+/// |p - q|_1 over the sphere by a midpoint rule of m x 2m nodes in (theta, phi) of l, tangent
+/// frame of n, v = (sin theta_v, 0, mu).
+double sphere_l1(double mu, double r, const ibl::lobe_mixture& mx, ibl::ld_weight w, int m) {
+    const double alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(r));
+    const d3 v(std::sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
+    const ibl::vec2<double> ab = ibl::dfg_exact<model>(mu, r);
+    const double e = ab.x + ab.y;
+    double norm[ibl::lobe_max_taps] = {}, ta[ibl::lobe_max_taps] = {};
+    for (int k = 0; k < mx.count; ++k) {
+        norm[k] = ibl::ld_kernel_normaliser(mx.taps[std::size_t(k)].roughness, w, 4096);
+        ta[k] = ibl::clamp_alpha(ibl::alpha_from_roughness(mx.taps[std::size_t(k)].roughness));
+    }
+    double s = 0.0;
+    for (int j = 0; j < m; ++j) {
+        const double th = (j + 0.5) * pi / m;
+        for (int i = 0; i < 2 * m; ++i) {
+            const double ph = (i + 0.5) * pi / m;
+            const d3 l(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+            double p = 0.0;
+            if (l.z > 0.0) {
+                const d3 h = glm::normalize(v + l);
+                p = ibl::ndf_ggx(h.z, alpha) * model::visibility(mu, l.z, r) * l.z / e;
+            }
+            double q = 0.0;
+            for (int k = 0; k < mx.count; ++k) {
+                const ibl::lobe_tap& t = mx.taps[std::size_t(k)];
+                const d3 d(-std::sin(t.angle), 0.0, std::cos(t.angle));
+                q += t.weight * ibl::ld_kernel_value(glm::dot(d, l), ta[k], norm[k], w);
+            }
+            s += std::fabs(p - q) * std::sin(th);
+        }
+    }
+    return s * (pi / m) * (pi / m);
+}
+
+ibl::cubemap<float> constant_chain(float value, int size = 16, int levels = 5) {
+    ibl::cubemap<float> c(size, levels);
+    for (int l = 0; l < levels; ++l) c.fill(l, [&](int, int, int) { return f3(value); });
+    c.update_borders();
+    return c;
+}
+
+} // namespace
+
+TEST_CASE("lobe fit: the chain kernel's normaliser and density against a polar-angle quadrature") {
+    for (const ibl::ld_weight w : {ibl::ld_weight::n_dot_l, ibl::ld_weight::g1})
+        for (const double r : {0.2, 0.5, 0.8, 1.0}) {
+            const double q1 = polar_kernel_integral(r, w, 4096, false), q2 = polar_kernel_integral(r, w, 8192, false);
+            const double n1 = ibl::ld_kernel_normaliser(r, w, 1024), n2 = ibl::ld_kernel_normaliser(r, w, 2048);
+            CHECK(std::fabs(n2 - q2) <= std::fabs(q2 - q1) + std::fabs(n2 - n1) + 1e-12);
+            CHECK(std::fabs(ibl::detail::ld_kernel_normaliser_tabulated(r, w) - n2) <= 1e-6 * n2);
+            const double k1 = polar_kernel_integral(r, w, 4096, true), k2 = polar_kernel_integral(r, w, 8192, true);
+            CHECK(std::fabs(k2 - 1.0) <= std::fabs(k2 - k1) + 1e-6); // 1e-6: the 4096-node normaliser
+        }
+}
+
+TEST_CASE("lobe fit: the L1 estimator over the lobe's draws equals a direct quadrature over the sphere") {
+    for (const double mu : {0.2, 0.6})
+        for (const double r : {0.5, 0.8}) {
+            ibl::lobe_mixture mx;
+            mx.count = 2;
+            mx.taps[0] = {0.3, 0.6 * r, 0.6};
+            mx.taps[1] = {0.9, 0.5 * r, 0.4};
+            const ibl::detail::lobe_points p64 = ibl::detail::make_lobe_points<model>(mu, r, 64);
+            const ibl::detail::lobe_points p128 = ibl::detail::make_lobe_points<model>(mu, r, 128);
+            const double e64 = ibl::detail::mixture_l1(p64, mx.taps, 2, ibl::ld_weight::g1, {});
+            const double e128 = ibl::detail::mixture_l1(p128, mx.taps, 2, ibl::ld_weight::g1, {});
+            const double s1 = sphere_l1(mu, r, mx, ibl::ld_weight::g1, 256), s2 = sphere_l1(mu, r, mx, ibl::ld_weight::g1, 512);
+            INFO("mu " << mu << " r " << r << " estimate " << e128 << " sphere " << s2);
+            CHECK(std::fabs(e128 - s2) <= std::fabs(e128 - e64) + std::fabs(s2 - s1) + 1e-3);
+        }
+}
+
+TEST_CASE("lobe fit: at n.v = 1 a G1 chain's kernel is the lobe, found exactly") {
+    for (const double r : {0.3, 0.6, 0.9}) {
+        ibl::lobe_fit_options o;
+        o.nodes = 32;
+        const ibl::lobe_mixture m = ibl::fit_specular_lobe<model>(1.0, r, ibl::ld_weight::g1, o);
+        INFO("r " << r << " angle " << m.taps[0].angle << " r' " << m.taps[0].roughness << " L1 " << m.l1);
+        CHECK(m.count == 1);
+        CHECK(std::fabs(m.taps[0].angle) < 0.02);
+        CHECK(std::fabs(m.taps[0].roughness - r) < 0.01);
+        CHECK(m.l1 < 0.01);
+        CHECK(m.taps[0].weight == 1.0);
+    }
+}
+
+TEST_CASE("lobe fit: at grazing views the fit beats the moment match and more taps do not lose") {
+    for (const double mu : {0.15, 0.5})
+        for (const double r : {0.3, 0.65}) {
+            double prev = 2.0;
+            for (int k = 1; k <= 3; ++k) {
+                ibl::lobe_fit_options o;
+                o.taps = k;
+                const ibl::lobe_mixture m = ibl::fit_specular_lobe<model>(mu, r, ibl::ld_weight::g1, o);
+                INFO("mu " << mu << " r " << r << " taps " << k << " L1 " << m.l1 << " moments " << m.l1_moments);
+                CHECK(m.l1 < m.l1_moments);
+                CHECK(m.l1 <= prev + 0.01);
+                double ws = 0.0;
+                for (int t = 0; t < k; ++t) {
+                    ws += m.taps[std::size_t(t)].weight;
+                    if (t > 0) CHECK(m.taps[std::size_t(t)].angle >= m.taps[std::size_t(t - 1)].angle);
+                }
+                CHECK(ws == doctest::Approx(1.0).epsilon(1e-12));
+                prev = m.l1;
+            }
+        }
+}
+
+TEST_CASE("lobe fit: tables hold the DFG terms, normalised taps and the mirror row") {
+    const ibl::dfg_lut_layout lay{};
+    ibl::lobe_fit_options o;
+    o.taps = 2;
+    const ibl::lobe_taps_lut t = ibl::make_lobe_taps_lut<model>(6, lay, ibl::ld_weight::g1, o, ibl::serial_executor{});
+    REQUIRE(t.channels == 8u);
+    const ibl::dfg_lut ab = ibl::make_dfg_lut_exact<model>(6, lay, 2);
+    for (std::uint32_t j = 0; j < 6; ++j)
+        for (std::uint32_t i = 0; i < 6; ++i) {
+            const float* p = &t.data[(j * 6 + i) * t.channels];
+            CHECK(p[0] == ab.data[(j * 6 + i) * 2]);
+            CHECK(p[1] == ab.data[(j * 6 + i) * 2 + 1]);
+            CHECK(double(p[4] + p[7]) == doctest::Approx(1.0).epsilon(4 * feps));
+            CHECK(std::fabs(p[2]) <= 1.0f);
+            CHECK(std::fabs(p[5]) <= 1.0f);
+        }
+    const double mu0 = ibl::dfg_texel_value<double>(lay.n_dot_v, 3, 6, lay.edge_aligned);
+    CHECK(double(t.data[3 * t.channels + 2]) == doctest::Approx(std::acos(mu0) / ibl::half_pi_v<double>).epsilon(4 * feps));
+    CHECK(t.data[3 * t.channels + 3] == 0.0f);
+    CHECK(t.mean_l1 > 0.0);
+    CHECK(t.max_l1 >= t.mean_l1);
+
+    const ibl::lobe_lut l = ibl::make_lobe_lut_fitted<model>(6, lay, ibl::ld_weight::g1, {}, ibl::serial_executor{});
+    for (std::uint32_t j = 1; j < 6; ++j) {
+        const double r = ibl::dfg_texel_value<double>(lay.roughness, j, 6, lay.edge_aligned);
+        const float* p = &l.data[(j * 6 + 5) * 4]; // the n.v = 1 column: r_eff = r
+        CHECK(p[2] >= 0.0f);
+        CHECK(p[2] <= 1.0f);
+        if (r >= 0.2) CHECK(std::fabs(double(p[3]) - r) < 0.01);
+    }
+}
+
+TEST_CASE("lobe fit: both fitted runtime models are exact in a constant environment (white furnace)") {
+    const ibl::dfg_lut_layout lay{};
+    ibl::lobe_fit_options o;
+    o.taps = 3;
+    const ibl::lobe_taps_lut t = ibl::make_lobe_taps_lut<model>(8, lay, ibl::ld_weight::g1, o, ibl::serial_executor{});
+    const ibl::lobe_lut l = ibl::make_lobe_lut_fitted<model>(8, lay, ibl::ld_weight::g1, {}, ibl::serial_executor{});
+    const ibl::cubemap<float> chain = constant_chain(1.5f);
+    const d3 n = glm::normalize(d3(-0.2, 0.9, 0.3));
+    const ibl::frame<double> fr = ibl::make_frame(n);
+    for (const double mu : {0.15, 0.5, 1.0})
+        for (const double r : {0.3, 0.7}) {
+            const double s = std::sqrt((1.0 - mu) * (1.0 + mu));
+            const d3 v = fr.to_world(d3(0.6 * s, 0.8 * s, mu));
+            const f3 a = ibl::specular_lobe_taps(chain, ibl::specular_lookup_desc{}, t, lay, f3(n), f3(v), float(r), f3(1.0f), f3(1.0f));
+            const f3 b = ibl::specular_lobe(chain, ibl::specular_lookup_desc{}, l, lay, f3(n), f3(v), float(r), f3(1.0f), f3(1.0f));
+            const ibl::vec4<float> ab = ibl::lobe_lut_lookup(l, float(mu), float(r), lay);
+            CHECK(double(a.x) == doctest::Approx(1.5 * double(ab.x + ab.y)).epsilon(16 * feps));
+            CHECK(double(b.x) == doctest::Approx(1.5 * double(ab.x + ab.y)).epsilon(16 * feps));
+        }
+}
