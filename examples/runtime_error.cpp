@@ -122,6 +122,9 @@ f3 fis(const ibl::cubemap<float>& chain, const products& p, const shading_point&
     return ibl::specular_fis(chain, d, s.n, s.v, s.roughness, s.f0, f3(1.0f), ibl::vec2<float>(abk.x, abk.y));
 }
 
+int g_levels = 6;    ///< chain levels (levels=N on the command line)
+double g_leak = 0.0; ///< leak_weight of the per-cell fits (leak=X)
+
 /// Fitted mixtures per (r, n.v) cell and tap count (index [count - 1][r][mu]).
 struct fitted_cells {
     std::vector<ibl::lobe_mixture> m[6];
@@ -145,6 +148,7 @@ void make_fits(ibl::ld_weight w) {
                 o.taps = c;
                 o.nodes = 32;
                 o.iterations = 150;
+                o.leak_weight = g_leak;
                 g_fits.m[c - 1][i] = ibl::fit_specular_lobe<model>(k_n_dot_v[i % n_mu], k_roughness[i / n_mu], w, o);
             }
         });
@@ -372,7 +376,6 @@ std::vector<std::uint32_t> tool_samples(int levels) {
     return s;
 }
 
-int g_levels = 6; ///< chain levels (levels=N on the command line)
 
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, ibl::ld_weight w) {
     ibl::prefilter_options o;
@@ -436,6 +439,7 @@ int main(int argc, char** argv) {
     const bool fit_mode = argc > 1 && std::strcmp(argv[1], "fit") == 0;
     for (int a = 1; a < argc; ++a)
         if (std::strncmp(argv[a], "levels=", 7) == 0) g_levels = std::clamp(std::atoi(argv[a] + 7), 2, 9);
+        else if (std::strncmp(argv[a], "leak=", 5) == 0) g_leak = std::atof(argv[a] + 5);
     std::printf("chain: 256^2, %d levels, linear roughness l / %d\n", g_levels, g_levels - 1);
     const std::uint32_t points = quick || explore ? 8 : 64;
     const std::uint32_t ref_samples = quick || explore ? 1u << 13 : 1u << 15;

@@ -1,6 +1,6 @@
 // tests/test_lobe_fit.cpp — the lobe fit (integrate/lobe_fit.hpp) and the fitted-taps runtime
 // (runtime.hpp): the chain kernel's normaliser and density against an independent quadrature in
-// the polar angle, the L1 estimator over the lobe's draws against a direct quadrature of |p - q|
+// the polar angle, its mass below the horizon against a sphere quadrature, the L1 estimator over the lobe's draws against a direct quadrature of |p - q|
 // over the whole sphere (p from the model's D and V, normalised by dfg_exact), the fit's exact
 // answer at n.v = 1 for a G1 chain (the lobe is the kernel there), the fit against the moment match
 // and against fewer taps at grazing views, the tables (A, B equal to the DFG table, weights
@@ -204,5 +204,35 @@ TEST_CASE("lobe fit: both fitted runtime models are exact in a constant environm
             const ibl::vec4<float> ab = ibl::lobe_lut_lookup(l, float(mu), float(r), lay);
             CHECK(double(a.x) == doctest::Approx(1.5 * double(ab.x + ab.y)).epsilon(16 * feps));
             CHECK(double(b.x) == doctest::Approx(1.5 * double(ab.x + ab.y)).epsilon(16 * feps));
+        }
+}
+
+TEST_CASE("lobe fit: a kernel's mass below the horizon against a direct sphere quadrature") {
+    for (const double a : {0.0, 0.8, 1.3, 1.5})
+        for (const double r : {0.3, 0.7}) {
+            const double alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(r));
+            const double norm = ibl::ld_kernel_normaliser(r, ibl::ld_weight::g1, 4096);
+            const d3 d(-std::sin(a), 0.0, std::cos(a));
+            auto below = [&](int m) {
+                double s = 0.0;
+                for (int j = 0; j < m; ++j) {
+                    const double th = ibl::half_pi_v<double> + (j + 0.5) * ibl::half_pi_v<double> / m; // l.z < 0
+                    for (int i = 0; i < 4 * m; ++i) {
+                        const double ph = (i + 0.5) * 2.0 * pi / (4 * m);
+                        const d3 l(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+                        s += ibl::ld_kernel_value(glm::dot(d, l), alpha, norm, ibl::ld_weight::g1) * std::sin(th);
+                    }
+                }
+                return s * (ibl::half_pi_v<double> / m) * (2.0 * pi / (4 * m));
+            };
+            const double q1 = below(256), q2 = below(512);
+            // The azimuthal fraction has square-root kinks where the cone of beta touches the
+            // horizon: the node rule converges non-monotonically, so its error bound is the spread
+            // of three resolutions.
+            const double e = ibl::detail::ld_kernel_mass_below(a, r, ibl::ld_weight::g1, 8192);
+            const double spread = std::max(std::fabs(e - ibl::detail::ld_kernel_mass_below(a, r, ibl::ld_weight::g1, 4096)),
+                                           std::fabs(e - ibl::detail::ld_kernel_mass_below(a, r, ibl::ld_weight::g1, 2048)));
+            INFO("angle " << a << " r " << r << " quadrature " << q2 << " mass_below " << e);
+            CHECK(std::fabs(e - q2) <= std::fabs(q2 - q1) + spread + 1e-7);
         }
 }
