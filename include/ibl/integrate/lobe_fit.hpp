@@ -132,6 +132,9 @@ struct lobe_fit_options {
     /// a leak there is the mixture's most harmful error; leak_weight > 0 trades more misplacement
     /// inside the hemisphere for less leakage.
     double leak_weight = 0.0;
+    /// Nelder-Mead stops once its simplex's objective values agree within this (L1 units; 0:
+    /// always the full iteration count).
+    double tolerance = 1e-5;
 };
 
 namespace detail {
@@ -259,8 +262,10 @@ inline double mixture_l1(const lobe_points& pts, const std::array<lobe_tap, lobe
     return pts.weight_sum > 0.0 ? 2.0 * s / pts.weight_sum : 2.0;
 }
 
-/// Nelder-Mead minimisation of f over n <= 9 parameters from x0 with initial steps `step`.
-template <class F> double nelder_mead(F&& f, std::vector<double>& x0, const std::vector<double>& step, int iterations) {
+/// Nelder-Mead minimisation of f from x0 with initial steps `step`: at most `iterations`
+/// iterations, stopping early once the simplex's values agree within `tolerance`.
+template <class F>
+double nelder_mead(F&& f, std::vector<double>& x0, const std::vector<double>& step, int iterations, double tolerance) {
     const std::size_t n = x0.size();
     std::vector<std::vector<double>> s(n + 1, x0);
     std::vector<double> fv(n + 1);
@@ -273,6 +278,7 @@ template <class F> double nelder_mead(F&& f, std::vector<double>& x0, const std:
             if (fv[i] < fv[lo]) lo = i;
             if (fv[i] > fv[hi]) hi = i;
         }
+        if (fv[hi] - fv[lo] <= tolerance) break;
         std::size_t hi2 = lo;
         for (std::size_t i = 0; i <= n; ++i)
             if (i != hi && fv[i] > fv[hi2]) hi2 = i;
@@ -370,7 +376,7 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
         };
         std::vector<double> step(x.size());
         for (std::size_t j = 0; j < x.size(); ++j) step[j] = j % 3 == 0 ? spread : j % 3 == 1 ? 0.1 * vmax : 0.2;
-        best = detail::nelder_mead(f, x, step, o.iterations * int(x.size()));
+        best = detail::nelder_mead(f, x, step, o.iterations * int(x.size()), o.tolerance);
         // weights as parameters: renormalise so the next split starts from the same mixture
         double ws = 0.0;
         for (int k = 0; k < nk; ++k) ws += std::max(x[std::size_t(3 * k + 2)], 0.0);
