@@ -24,9 +24,6 @@ inline double ld_weight_factor(ld_weight w, double mu, double alpha) noexcept {
     return w == ld_weight::g1 ? g1_smith_ggx(m, alpha) : m;
 }
 
-/// "n_dot_l" or "g1" (the names of report.json and the KTX2 key/value data of ibl-bake).
-inline const char* ld_weight_name(ld_weight w) noexcept { return w == ld_weight::g1 ? "g1" : "n_dot_l"; }
-
 } // namespace ibl
 
 #endif // IBL_DETAIL_CXX20
