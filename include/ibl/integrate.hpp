@@ -8,6 +8,7 @@
 #include "integrate/disk_light.hpp"
 #include "integrate/env_importance.hpp"
 #include "integrate/irradiance.hpp"
+#include "integrate/ld_weight.hpp"
 #include "integrate/lookup_error.hpp"
 #include "integrate/metrics.hpp"
 #include "integrate/prefilter.hpp"

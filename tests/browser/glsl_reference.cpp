@@ -9,6 +9,7 @@
 #include <vector>
 
 #include <ibl/lookup.hpp>
+#include <ibl/runtime.hpp>
 #include <ibl/shade.hpp>
 #include <ibl/sh/convolve.hpp>
 
@@ -114,6 +115,12 @@ v4 row_value(int j, int i) {
         mat2.roughness = 0.25f + 0.75f * x;
         return {ibl::shade_disk(n, v, sun, ibl::resolve_material(mat2)), 0.0f};
     }
+    if (j == 16) return {ibl::lerp_direction(dir_of(i), dir_of(63 - i), 2.0f * x - 0.5f), 0.0f};
+    if (j == 17) { // as ibl::specular_lobe forms its direction
+        const v3 a = dir_of(i), b = dir_of(63 - i);
+        const v3 d = ibl::lerp_direction(a, 2.0f * glm::dot(a, b) * a - b, x);
+        return {d, glm::dot(d, a)};
+    }
     if (j == 12)
         return {ibl::roughness_from_lod(ibl::roughness_mapping::filament, x * 4.0f, 4.0f),
                 ibl::lod_from_roughness(ibl::roughness_mapping::filament, x, 4.0f),
@@ -177,8 +184,10 @@ int main() {
         {"cap_irradiance", 1e-5, 1e-6},
         {"disk_light_specular (0.25 sr)", 1e-5 + disk_rel(0.25, 0.0), 1e-6},
         {"shade_disk (sun, r >= 0.25)", 1e-5 + disk_rel(6.8e-5, 0.25), 1e-6},
+        {"lerp_direction", 1e-5, 1e-6},
+        {"lobe direction (+ its n.d)", 1e-5, 1e-6},
     };
-    std::printf("{\"width\": %d, \"height\": 16, \"rows\": [", width);
+    std::printf("{\"width\": %d, \"height\": 18, \"rows\": [", width);
     const int n_rows = int(sizeof(rows) / sizeof(rows[0]));
     for (int j = 0; j < n_rows; ++j) {
         std::printf("%s\n{\"row\": %d, \"name\": \"%s\", \"rel\": %g, \"abs\": %g, \"values\": [", j ? "," : "", j, rows[j].name,

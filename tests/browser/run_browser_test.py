@@ -5,7 +5,8 @@ SwiftShader's WebGL2), compared with the C++.
   preview  bakes a small folder with the built ibl-bake (--size 32 --quality low), serves the
            repository's tools/viewer/ and include/ibl/glsl/ and the folder on 127.0.0.1, lets
            tools/viewer/index.html?test=preview render ibl-bake's preview grid from specular.ktx2,
-           dfg.hpp, sh.json and report.json, and compares its pixels with the bake's own
+           dfg.hpp, lobe_lut.hpp (the default runtime model; --preset filament / gltf bake the
+           split sum), sh.json and report.json, and compares its pixels with the bake's own
            preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
            interactive viewer to --out (docs/shaders-viewer.png).
@@ -252,6 +253,12 @@ def max_slope_8bit():
     return best
 
 
+def report_model(bake_dir):
+    """The runtime model report.json names (plan.runtime.runtime_model.name)."""
+    rt = json.load(open(os.path.join(bake_dir, "report.json")))["plan"]["runtime"]
+    return rt.get("runtime_model", {}).get("name", "split-sum")
+
+
 def compare_preview(bake_dir, result):
     w, h, ref = read_png_rgb(os.path.join(bake_dir, "preview.png"))
     got = base64.b64decode(result["rgb"])
@@ -283,6 +290,15 @@ def compare_preview(bake_dir, result):
             raise RuntimeError(f"no bound derived for a {f} texture")
     if info["lut_texture"] != "RGBA32F":
         raise RuntimeError("the DFG table is not an RGBA32F texture (no OES_texture_float_linear): no bound derived")
+    # The lobe model (report.json runtime_model "lobe"): lobe_lut.hpp's exact floats in an RGBA32F
+    # texture (no storage error); its lookup direction normalize(lerp(n, R, s)) and r_eff are formed
+    # in float on both sides (the C++ reads the table and the chain in float too): inside the
+    # arithmetic term below.
+    expected_model = report_model(bake_dir)
+    if info.get("runtime_model") != expected_model:
+        raise RuntimeError(f"the page shaded with {info.get('runtime_model')!r}, the bake's model is {expected_model!r}")
+    if expected_model == "lobe" and info.get("lobe_texture") != "RGBA32F":
+        raise RuntimeError("the lobe LUT is not an RGBA32F texture: no bound derived")
     eps = max(chain_eps[f] for f in formats) + 1e-5
     # The sun (lights.json) as a disk light: its specular D(n.h; alpha') turns an error dc of n.h
     # into a relative error <= 4 dc / alpha'^2 (at the lobe's peak, c = 1), alpha'^2 >= tan^2(r/2)
@@ -326,6 +342,8 @@ def compare_preview(bake_dir, result):
     print(f"diffuse {info['runtime']['diffuse']}" + (f" ({info['irradiance_format']})" if len(formats) > 1 else ""))
     print(f"chain {info['chain_format']} levels {info['chain_levels']}, DFG texture {info['lut_texture']} "
           f"{info['lut_size']}^2, exposure {info['exposure']:.8g}, {ss}x{ss} samples per pixel")
+    print(f"runtime model {info['runtime_model']}" +
+          (f" (lobe LUT {info['lobe_texture']} {info['lobe_size']}^2)" if info['runtime_model'] == "lobe" else ""))
     print(f"sun: " + (f"omega {info['sun']['solidAngle']:.6g} sr, specular term's eps {sun_eps:.3g}" if info.get("sun") else "none"))
     print(f"derived: eps = {eps:.3g} relative, max 8-bit slope {slope:.2f} per unit ln L, delta {delta:.3f} "
           f"-> bound {bound} (8-bit units)")

@@ -93,6 +93,8 @@ void apply_preset(bake_options& o, const std::string& p) {
     o.mirror = p == "filament";
     o.extract_sun = engine ? "off" : "auto";
     o.irradiance_size = engine ? 0 : 32;
+    o.ld_weight = engine ? "nl" : "g1";
+    o.runtime = engine ? "split-sum" : "lobe";
 }
 
 using handler = std::function<void(bake_options&, const std::string&)>;
@@ -137,6 +139,8 @@ const std::map<std::string, option_spec>& option_table() {
         {"--specular-lookup", {true, [](bake_options& o, const std::string& v) {
              o.specular_lookup = choice("--specular-lookup", v, {"default", "textbook"});
          }}},
+        {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {"g1", "nl"}); }}},
+        {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {"lobe", "split-sum"}); }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
@@ -246,8 +250,10 @@ std::string usage_text() {
            "  --sheen            also the Charlie sheen chain and the sheen albedo LUT\n"
            "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
            "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
+           "  --ld-weight W      g1 (default: D G1, the true lobe at n.v = 1) | nl (Karis D n.l): the chain's weight\n"
+           "  --runtime M        lobe (default: LD(lerp(n, R, s), r_eff) from the lobe LUT) | split-sum (LD(R, r) DFG)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
-           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB\n"
+           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --help, --version\n";

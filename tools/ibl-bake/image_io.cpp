@@ -1030,6 +1030,63 @@ std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::stri
 
 void write_exr(const std::string& path, const image_rgb32f& image) { write_file_atomic(path, encode_exr(image, path)); }
 
+std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name) {
+    if (image.width < 1 || image.height < 1 || image.rgba.size() != std::size_t(image.width) * std::size_t(image.height) * 4)
+        throw image_error(name, "RGBA image of " + std::to_string(image.rgba.size()) + " floats does not match its size");
+    std::vector<unsigned char> out;
+    try {
+        Imf::Header header(image.width, image.height);
+        header.compression() = Imf::ZIP_COMPRESSION;
+        const char* names[4] = {"R", "G", "B", "A"};
+        for (const char* ch : names) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
+        vector_ostream os(out);
+        Imf::OutputFile file(os, header, exr_threads);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(const_cast<float*>(image.rgba.data()));
+        const std::size_t xs = 4 * sizeof(float), ys = xs * std::size_t(image.width);
+        for (std::size_t c = 0; c < 4; ++c) fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys));
+        file.setFrameBuffer(fb);
+        file.writePixels(image.height);
+    } catch (const std::exception& e) {
+        throw image_error(name, std::string("OpenEXR encoding failed (") + printable(e.what(), 200) + ")");
+    }
+    return out;
+}
+
+void write_exr_rgba(const std::string& path, const image_rgba32f& image) { write_file_atomic(path, encode_exr_rgba(image, path)); }
+
+image_rgba32f read_exr_rgba(const std::string& path) {
+    const std::vector<unsigned char> bytes = read_file(path);
+    const std::span<const unsigned char> b(bytes);
+    if (b.size() < 8 || std::memcmp(b.data(), exr_magic, 4) != 0) throw image_error(path, "not an OpenEXR file");
+    (void)scan_exr_headers(b, path, read_options{});
+    span_istream in(b, path);
+    image_rgba32f img;
+    try {
+        Imf::MultiPartInputFile file(in, exr_threads);
+        Imf::InputPart part(file, 0);
+        const Imath::Box2i dw = part.header().dataWindow();
+        img.width = dw.max.x - dw.min.x + 1;
+        img.height = dw.max.y - dw.min.y + 1;
+        if (dw.min.x != 0 || dw.min.y != 0 || img.width < 1 || img.height < 1 || img.width > 4096 || img.height > 4096)
+            throw image_error(path, "unexpected data window for an RGBA table");
+        img.rgba.assign(std::size_t(img.width) * std::size_t(img.height) * 4, 0.0f);
+        Imf::FrameBuffer fb;
+        char* base = reinterpret_cast<char*>(img.rgba.data());
+        const std::size_t xs = 4 * sizeof(float), ys = xs * std::size_t(img.width);
+        const char* names[4] = {"R", "G", "B", "A"};
+        for (std::size_t c = 0; c < 4; ++c) fb.insert(names[c], Imf::Slice(Imf::FLOAT, base + c * sizeof(float), xs, ys, 1, 1, 0.0));
+        part.setFrameBuffer(fb);
+        part.readPixels(0, img.height - 1);
+    } catch (const image_error&) {
+        throw;
+    } catch (const std::exception& e) {
+        throw image_error(path, std::string(in.past_end() ? "truncated OpenEXR file" : "corrupt OpenEXR data") + " (OpenEXR: " +
+                                    printable(e.what(), 200) + ")");
+    }
+    return img;
+}
+
 std::vector<unsigned char> encode_hdr(const image_rgb32f& image, const std::string& name) {
     check_image(image, name);
     // stb converts x * 2^(8 - e) to unsigned char: UB for negative x, and the exponent byte wraps

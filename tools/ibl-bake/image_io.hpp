@@ -162,6 +162,17 @@ image_rgb32f read_latlong(const std::string& path, const read_options& options =
 std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name = "<exr>");
 void write_exr(const std::string& path, const image_rgb32f& image);
 
+/// A four-channel float image (R, G, B, A interleaved, row 0 first): the lobe LUT's file.
+struct image_rgba32f {
+    int width = 0, height = 0;
+    std::vector<float> rgba;
+};
+/// Float32 RGBA OpenEXR (ZIP); read back by read_exr_rgba (a missing channel reads as 0; the data
+/// window must start at (0, 0), at most 4096 x 4096). Both throw image_error.
+std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name = "<exr>");
+void write_exr_rgba(const std::string& path, const image_rgba32f& image);
+image_rgba32f read_exr_rgba(const std::string& path);
+
 /// Radiance HDR (RGBE, run-length encoded for widths 8..32767). RGBE stores one shared exponent e
 /// (2^(e-1) <= max(r, g, b) < 2^e) and an 8-bit mantissa per channel; stb truncates on encoding
 /// and decodes without centring, so each channel comes back as x' with |x - x'| < 2^(e-8), i.e.

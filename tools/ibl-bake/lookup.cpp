@@ -112,7 +112,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         need(4);
         if (!b.has_chain) throw std::invalid_argument("the bake has no specular chain");
         const dvec3 d = unit(a[0], a[1], a[2], "the direction");
-        return triple(v.ld(d, unit_interval(a[3])) + sun_ld(v.sun, d, unit_interval(a[3])));
+        return triple(v.ld(d, unit_interval(a[3])) + sun_ld(v.sun, d, unit_interval(a[3]), v.weight));
     }
     if (word == "dfg") {
         need(2);
@@ -147,7 +147,13 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen table (bake with --sheen)");
         return fmt9(b.sheen_lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1]))).x);
     }
-    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen)");
+    if (word == "lobe") {
+        need(2);
+        if (!b.has_lobe) throw std::invalid_argument("the bake has no lobe LUT (bake with --runtime lobe)");
+        const ibl::vec4<double> p = v.lobe_params(unit_interval(a[0]), unit_interval(a[1]));
+        return fmt9(p.x) + " " + fmt9(p.y) + " " + fmt9(p.z) + " " + fmt9(p.w);
+    }
+    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe)");
 }
 
 } // namespace
@@ -163,8 +169,25 @@ product_view baked_folder::view() const {
     v.specular = specular;
     v.dfg_layout = dfg_layout;
     v.sun = sun ? &*sun : nullptr;
+    v.lobe = has_lobe ? &lobe : nullptr;
+    v.weight = weight;
     return v;
 }
+
+namespace {
+/// The runtime model of plan.runtime (bakes before it: the split sum of an n.l chain).
+void load_runtime_model(baked_folder& b, const json_value& rt, const std::string& dir) {
+    if (const json_value* w = rt.find("ld_weight"); w && w->find("name")) b.weight = ld_weight_named(w->find("name")->string);
+    const json_value* m = rt.find("runtime_model");
+    if (!m || !m->find("name") || m->find("name")->string != "lobe") return;
+    const image_rgba32f img = read_exr_rgba(dir + "/lobe_lut.exr");
+    if (img.width != img.height) throw std::runtime_error(dir + "/lobe_lut.exr: the lobe LUT is not square");
+    b.lobe.size = std::uint32_t(img.width);
+    b.lobe.data = img.rgba;
+    b.lobe.weight = b.weight;
+    b.has_lobe = true;
+}
+} // namespace
 
 baked_folder load_baked_folder(const std::string& dir) {
     const std::string rp = dir + "/report.json";
@@ -208,6 +231,7 @@ baked_folder load_baked_folder(const std::string& dir) {
             for (int i = 0; i < img.width; ++i) b.sheen_lut.data.push_back(img.texel(i, j)[0]);
         b.has_sheen = true;
     }
+    load_runtime_model(b, rt, dir);
     const std::string diffuse = member(rt, "diffuse", rp).string;
     if (diffuse == "sh") b.diffuse = sh_from_json(dir + "/sh.json");
     else if (diffuse == "irradiance_map") {

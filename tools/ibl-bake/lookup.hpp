@@ -1,7 +1,7 @@
 #pragma once
 // tools/ibl-bake/lookup.hpp — `ibl-bake --lookup DIR`: answers queries about a bake folder exactly
 // as the documented runtime code does, from the files in DIR (report.json's plan.runtime,
-// specular.ktx2, dfg.exr, sh.json or irradiance.ktx2).
+// specular.ktx2, dfg.exr, lobe_lut.exr, sh.json or irradiance.ktx2).
 //
 // Queries on stdin, one per line, one answer line each (numbers separated by spaces; lines that
 // are empty or start with # are skipped, without an answer):
@@ -15,6 +15,11 @@
 //   sheen X Y Z R               -> r g b   Charlie LD of the whole environment (a --sheen bake): the sheen
 //                                 chain at lod = r (V - 1) plus an extracted sun's Charlie term
 //   dfg_sheen NV R              -> E       the sheen albedo lookup (bilinear, texel centres)
+//   lobe NV R                   -> A B s r_eff   the lobe LUT lookup (a --runtime lobe bake;
+//                                 ibl::lobe_lut_lookup in the DFG layout)
+// shade uses the bake's runtime model (report.json plan.runtime.runtime_model): lobe reads the
+// chain at normalize(lerp(n, R, s)) and r_eff with the lobe LUT's (A, B); split-sum at R and r
+// with the DFG table's. specular and dfg answer the chain and the DFG table themselves.
 // With a sun in lights.json the answers are about the whole environment: specular adds the sun's
 // exact LD term (ibl::disk_light_ld), irradiance its cap irradiance, shade its disk-light shading.
 // R, NV, M are clamped to [0, 1] as the runtime does. A malformed query (unknown word, wrong count,
@@ -44,6 +49,9 @@ struct baked_folder {
     ibl::cubemap<float> sheen{1};               ///< the Charlie chain (--sheen bakes)
     ibl::dfg_lut sheen_lut;
     bool has_sheen = false;
+    ibl::lobe_lut lobe;                         ///< lobe_lut.exr (runtime model lobe)
+    bool has_lobe = false;
+    ibl::ld_weight weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight (plan.runtime.ld_weight)
 
     product_view view() const;
 };

@@ -25,6 +25,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     s.push_back(make_sh_stage());
     s.push_back(make_irradiance_stage());
     s.push_back(make_dfg_stage());
+    s.push_back(make_lobe_lut_stage());
     s.push_back(make_sheen_stage());
     s.push_back(make_lookup_stage());
     s.push_back(make_split_sum_stage());
@@ -39,6 +40,7 @@ void add_time(product_times& t, const stage& s) {
                    : std::strcmp(c, "specular") == 0 ? &t.specular
                    : std::strcmp(c, "diffuse") == 0  ? &t.diffuse
                    : std::strcmp(c, "dfg") == 0      ? &t.dfg
+                   : std::strcmp(c, "lobe_lut") == 0 ? &t.lobe
                                                      : nullptr;
     if (slot) *slot += s.product_ms();
 }
@@ -85,7 +87,7 @@ std::string report_json(const bake_context& ctx, const std::vector<std::unique_p
     const product_times& t = ctx.measured;
     j.key("measured_ms").begin_object();
     j.key("source").value(t.source).key("specular").value(t.specular).key("diffuse").value(t.diffuse);
-    j.key("dfg").value(t.dfg).key("total").value(t.total());
+    j.key("dfg").value(t.dfg).key("lobe_lut").value(t.lobe).key("total").value(t.total());
     j.end_object();
     j.key("files").begin_array();
     for (const auto& f : files) j.value(f);
@@ -125,8 +127,8 @@ void print_report(std::FILE* out, const bake_context& ctx, const std::vector<std
     if (ctx.scene_mode) std::fprintf(out, "\n");
     print_table(out, rows);
     const product_times& t = ctx.measured;
-    std::fprintf(out, "\nproducts: source %.1f, specular %.1f, diffuse %.1f, dfg %.1f ms, total %.1f ms\n", t.source, t.specular,
-                 t.diffuse, t.dfg, t.total());
+    std::fprintf(out, "\nproducts: source %.1f, specular %.1f, diffuse %.1f, dfg %.1f, lobe lut %.1f ms, total %.1f ms\n", t.source,
+                 t.specular, t.diffuse, t.dfg, t.lobe, t.total());
     for (const auto& s : stages)
         for (const auto& line : s->notes_after()) std::fprintf(out, "%s\n", line.c_str());
     std::fprintf(out, "\ntotal %.0f ms; %zu files in %s\n", total_ms, files + 1, ctx.opt.out.c_str());

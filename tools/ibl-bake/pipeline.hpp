@@ -28,6 +28,7 @@
 #include <ibl/env/cubemap.hpp>
 #include <ibl/env/latlong.hpp>
 #include <ibl/integrate/dfg_lut.hpp>
+#include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/plan.hpp>
 #include <ibl/sh/basis.hpp>
 #include <ibl/shade.hpp>
@@ -87,8 +88,8 @@ struct diffuse_data {
 
 /// Measured time of the products by category (checks excluded).
 struct product_times {
-    double source = 0, specular = 0, diffuse = 0, dfg = 0;
-    double total() const { return source + specular + diffuse + dfg; }
+    double source = 0, specular = 0, diffuse = 0, dfg = 0, lobe = 0;
+    double total() const { return source + specular + diffuse + dfg + lobe; }
 };
 
 /// Everything the stages share: settings, the plan, the source and the products so far.
@@ -124,6 +125,7 @@ struct bake_context {
     // products (the product stages)
     std::optional<ibl::cubemap<float>> chain; ///< the stored levels of plan.specular
     std::optional<ibl::dfg_lut> lut;
+    std::optional<ibl::lobe_lut> lobe; ///< the lobe LUT (--runtime lobe)
     diffuse_data diffuse;
     product_times measured; ///< filled by the pipeline after each product stage
 };
@@ -159,7 +161,7 @@ public:
     virtual void report(json_writer& j) const = 0;
     /// Time of the product itself (checks excluded); product stages only.
     virtual double product_ms() const { return 0.0; }
-    /// The product category of measured_ms: "source", "specular", "diffuse" or "dfg".
+    /// The product category of measured_ms: "source", "specular", "diffuse", "dfg" or "lobe_lut".
     virtual const char* category() const { return ""; }
 };
 

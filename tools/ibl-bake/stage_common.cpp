@@ -15,6 +15,7 @@
 #include <ibl/integrate/disk_light.hpp>
 #include <ibl/sampling/lobe.hpp>
 #include <ibl/integrate/reference.hpp>
+#include <ibl/runtime.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
 
@@ -49,8 +50,9 @@ dvec3 product_view::irradiance(const dvec3& n) const {
     return e;
 }
 
-dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness) {
-    return sun ? ibl::disk_light_ld(*sun, d, roughness, 8) : dvec3(0.0); // 8 nodes agree with 128 to 1e-13 (docs/sun.md)
+dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness, ibl::ld_weight w) {
+    // n.l: 8 nodes agree with 128 to 1e-13 (docs/sun.md); G1 (Gauss-Legendre in u): to 2e-5 at 8
+    return sun ? ibl::disk_light_ld(*sun, d, roughness, 8, w) : dvec3(0.0);
 }
 
 dvec3 sheen_sun_ld(const ibl::disk_light<double>* sun, const dvec3& R, double roughness) {
@@ -69,17 +71,28 @@ dvec3 sheen_sun_ld(const ibl::disk_light<double>* sun, const dvec3& R, double ro
     return w > 0.0 ? sun->radiance * (sun->solid_angle * d / w) : dvec3(0.0);
 }
 
+ibl::vec4<double> product_view::lobe_params(double n_dot_v, double roughness) const {
+    return ibl::vec4<double>(ibl::lobe_lut_lookup(*lobe, float(n_dot_v), float(roughness), dfg_layout));
+}
+
 ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
     const double n_dot_v = std::clamp(glm::dot(n, v), 0.0, 1.0);
+    const dvec3 r_dir = 2.0 * glm::dot(n, v) * n - v;
     ibl::ibl_sample<double> s;
-    s.ld = ld(2.0 * glm::dot(n, v) * n - v, roughness);
+    if (diffuse) s.irradiance_over_pi = diffuse->irradiance_over_pi(n);
+    if (lobe) { // as ibl::specular_lobe: the direction in float, the chain at r_eff
+        const ibl::vec4<double> p = lobe_params(n_dot_v, roughness);
+        s.ld = ld(dvec3(ibl::lerp_direction(fvec3(n), fvec3(r_dir), float(p.z))), p.w);
+        s.dfg = ibl::vec2<double>(p.x, p.y);
+        return s;
+    }
+    s.ld = ld(r_dir, roughness);
     if (lut) {
         const fvec3 ab = ibl::dfg_lookup(*lut, float(n_dot_v), float(roughness), dfg_layout);
         s.dfg = ibl::vec2<double>(ab.x, ab.y);
     } else {
         s.dfg = ibl::dfg_exact<bake_model>(n_dot_v, roughness);
     }
-    if (diffuse) s.irradiance_over_pi = diffuse->irradiance_over_pi(n);
     return s;
 }
 
@@ -91,13 +104,50 @@ ibl::specular_lookup_desc specular_lookup_named(const std::string& name) {
     return name == "textbook" ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc{};
 }
 
+ibl::ld_weight ld_weight_named(const std::string& name) { return name == "g1" ? ibl::ld_weight::g1 : ibl::ld_weight::n_dot_l; }
+
+int lobe_lut_size_for(int dfg_size) { return std::clamp(dfg_size, 1, 24); }
+
+runtime_model runtime_model_of(const bake_options& o, const ibl::bake_plan& plan) {
+    runtime_model m;
+    m.ld_weight = o.ld_weight;
+    if (o.runtime == "lobe" && plan.dfg.enabled && plan.dfg.size > 0 && plan.specular.enabled) {
+        m.name = "lobe";
+        m.lobe_lut_size = lobe_lut_size_for(plan.dfg.size);
+    }
+    return m;
+}
+
 namespace {
 const char* axis_name(ibl::dfg_axis a) {
     return a == ibl::dfg_axis::cbrt ? "cbrt" : a == ibl::dfg_axis::sqrt ? "sqrt" : "linear";
 }
 } // namespace
 
-void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d) {
+namespace {
+void json_runtime_model(json_writer& j, const runtime_model& rm) {
+    j.key("ld_weight").begin_object();
+    j.key("name").value(rm.ld_weight);
+    j.key("rule").value(rm.ld_weight == "g1" ? "LD = int L D(h) G1(R.l) dl / int D(h) G1(R.l) dl (the specular lobe at n.v = 1)"
+                                             : "LD = int L D(h) (R.l) dl / int D(h) (R.l) dl (Karis 2013)");
+    j.end_object();
+    j.key("runtime_model").begin_object();
+    j.key("name").value(rm.name);
+    if (rm.name == "lobe") {
+        j.key("lut").value("lobe_lut.exr (lobe_lut.hpp)").key("lut_size").value(rm.lobe_lut_size);
+        j.key("channels").value("R = A, G = B, B = s, A = r_eff");
+        j.key("rule").value("(A, B, s, r_eff) = lobe LUT at (n.v, r) in the DFG layout (bilinear); specular = "
+                            "LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) (ibl::specular_lobe)");
+    } else {
+        j.key("rule").value("specular = LD(R, r) (F0 A + F90 B), (A, B) from the DFG table");
+    }
+    j.end_object();
+}
+} // namespace
+
+void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d,
+                             const runtime_model& rm) {
+    json_runtime_model(j, rm);
     j.key("specular_lookup").begin_object();
     const bool textbook = s.weight == ibl::level_weight::lod;
     j.key("name").value(textbook ? "textbook" : "log-geometric");
@@ -128,6 +178,8 @@ product_view baked_view(const bake_context& ctx) {
     v.lut = ctx.lut ? &*ctx.lut : nullptr;
     v.diffuse = &ctx.diffuse;
     v.sun = ctx.sun ? &*ctx.sun : nullptr;
+    v.lobe = ctx.lobe ? &*ctx.lobe : nullptr;
+    v.weight = ld_weight_named(ctx.opt.ld_weight);
     return v;
 }
 
@@ -220,8 +272,8 @@ void json_triples(json_writer& j, const sh5& c, int count) {
     j.end_array();
 }
 
-/// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples.
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, pool_executor& ex) {
+/// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex) {
     const int stored_base = std::max(1, sp.virtual_base_size >> sp.first_level);
     ibl::cubemap<float> chain(stored_base, int(sp.levels.size()));
     for (std::size_t k = 0; k < sp.levels.size(); ++k) {
@@ -236,7 +288,7 @@ ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specul
             continue;
         }
         ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
-            src, lp.roughness, lp.samples, ibl::prefilter_method::filtered_importance, 0.5);
+            src, lp.roughness, lp.samples, ibl::prefilter_method::filtered_importance, 0.5, w);
         table.trilinear = lp.trilinear;
         const std::vector<fvec3> texels = ibl::convolve_faces(src, table, n, ex);
         chain.fill(int(k), [&](int f, int x, int y) {

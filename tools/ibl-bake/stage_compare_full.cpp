@@ -155,7 +155,7 @@ void compare_full_stage::bake_full(bake_context& ctx) {
     fsource_ = bake_source(ctx.src, ctx.full.source_size, ctx.qs.bake_k, ctx.ex);
     tf_.source = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
-    fchain_ = bake_chain(fsource_, ctx.full.specular, ctx.ex);
+    fchain_ = bake_chain(fsource_, ctx.full.specular, ld_weight_named(ctx.opt.ld_weight), ctx.ex);
     tf_.specular = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     fdiffuse_ = sh3_diffuse(fsource_, ctx.ex);
@@ -178,7 +178,7 @@ void compare_full_stage::bake_converged(bake_context& ctx) {
         l.size = std::max(1, ctx.opt.size >> l.level);
         if (l.level > 0) l.samples = 4096;
     }
-    conv_.chain = bake_chain(fsource_, cp, ctx.ex);
+    conv_.chain = bake_chain(fsource_, cp, ld_weight_named(ctx.opt.ld_weight), ctx.ex);
     for (int f = 0; f < 6; ++f)
         for (int y = 0; y < 3; ++y)
             for (int x = 0; x < 3; ++x) conv_.normals.push_back(ibl::cube_texel_direction<double>(f, x, y, 3));
@@ -195,7 +195,7 @@ void compare_full_stage::shade(const bake_context& ctx) {
         pts.push_back({conv_.normals[i], glm::normalize(conv_.normals[i] + fr.t), i});
     }
     const std::vector<material_sample> mats = scene_materials(ctx.scene);
-    product_view planned = baked_view(ctx);
+    product_view planned = baked_view(ctx).split_sum(); // the plan's products, read as the full bake's are
     if (!diffuse_lit_) planned.diffuse = nullptr;
     const product_view full{&fchain_, ctx.set.policy, ctx.set.levels, 0, &*flut_, diffuse_lit_ ? &fdiffuse_ : nullptr};
     err_plan_ = compare_shading(mats, pts, planned, conv_, diffuse_lit_, ctx.scene.multiscatter);
@@ -206,6 +206,7 @@ void compare_full_stage::check_levels(bake_context& ctx) {
     ctx.prog.begin("specular levels vs reference");
     const dvec3 light = brightest_direction(fsource_, 0);
     const ibl::specular_plan& sp = ctx.plan.specular;
+    const ibl::ld_weight w = ld_weight_named(ctx.opt.ld_weight); // the chains' weight
     for (std::size_t k = 0; k < sp.levels.size(); ++k) {
         const ibl::specular_level_plan& lp = sp.levels[k];
         if (lp.level == 0 || !lp.needed) continue;
@@ -219,8 +220,8 @@ void compare_full_stage::check_levels(bake_context& ctx) {
             ctx.ex(tex.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i) {
                     const dvec3 d = ibl::cube_texel_direction<double>(tex[i][0], tex[i][1], tex[i][2], n);
-                    ref[i] = ctx.src.analytic ? ibl::reference_ld_sky(ctx.src.sky, d, lp.roughness, 2048, 16)
-                                              : ctx.src.visit([&](const auto& env) { return ibl::reference_ld(env, d, lp.roughness, 8192); });
+                    ref[i] = ctx.src.analytic ? ibl::reference_ld_sky(ctx.src.sky, d, lp.roughness, 2048, 16, w)
+                                              : ctx.src.visit([&](const auto& env) { return ibl::reference_ld(env, d, lp.roughness, 8192, w); });
                 }
             });
             ibl::error_accumulator acc(1e-3), acc_conv(1e-3);

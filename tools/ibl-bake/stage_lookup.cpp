@@ -43,6 +43,7 @@ public:
     void run(bake_context& ctx) override {
         ctx.prog.begin("check lookups");
         const auto t0 = std::chrono::steady_clock::now();
+        weight_ = ld_weight_named(ctx.opt.ld_weight); // every reference takes the chain's weight
         for (int k = 1; k <= 20; ++k) roughness_.push_back(0.05 * k);
         dirs_ = ibl::lookup_error_directions(ctx.qs.ref_grid, ctx.light);
         ibl::specular_lookup_desc chosen = specular_lookup_named(ctx.opt.specular_lookup);
@@ -88,11 +89,12 @@ private:
             std::vector<dvec3> out(d.size());
             ctx.ex(d.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i)
-                    out[i] = ibl::reference_ld_sky(ctx.src.sky, d[i], r, std::max(ctx.qs.sky_ref_samples / 4, 256u), ctx.qs.sun_cap_nodes);
+                    out[i] = ibl::reference_ld_sky(ctx.src.sky, d[i], r, std::max(ctx.qs.sky_ref_samples / 4, 256u), ctx.qs.sun_cap_nodes,
+                                                   weight_);
             });
             return out;
         }
-        return ibl::reference_ld_texel_sum(ctx.source, ibl::reference_ld_texel_level(ctx.source, r), d, r, ctx.ex);
+        return ibl::reference_ld_texel_sum(ctx.source, ibl::reference_ld_texel_level(ctx.source, r), d, r, ctx.ex, weight_);
     }
 
     /// With an extracted sun: the runtime's LD (the chain's lookup plus the sun's exact LD term)
@@ -110,7 +112,7 @@ private:
                 std::vector<dvec3> ref = ctx.src.analytic
                                              ? reference(ctx, dirs_, r) // the sky's exact LD holds its sun
                                              : ibl::reference_ld_texel_sum(ctx.whole_source(), ibl::reference_ld_texel_level(ctx.whole_source(), r),
-                                                                           std::span<const dvec3>(dirs_), r, ctx.ex);
+                                                                           std::span<const dvec3>(dirs_), r, ctx.ex, weight_);
                 it = whole_.emplace(r, std::move(ref)).first;
             }
             const std::vector<dvec3>& ref = it->second;
@@ -118,7 +120,7 @@ private:
             for (const auto& x : ref) mean += ibl::luminance(x) / double(ref.size());
             ibl::error_accumulator acc(std::max(1e-3 * mean, 1e-30));
             for (std::size_t i = 0; i < dirs_.size(); ++i)
-                acc.add(ibl::luminance(v.ld(dirs_[i], r) + sun_ld(v.sun, dirs_[i], r)), ibl::luminance(ref[i]));
+                acc.add(ibl::luminance(v.ld(dirs_[i], r) + sun_ld(v.sun, dirs_[i], r, weight_)), ibl::luminance(ref[i]));
             ibl::specular_lookup_report rep;
             rep.roughness = r;
             rep.total = acc.finish();
@@ -139,6 +141,7 @@ private:
     std::vector<dvec3> dirs_;
     std::vector<lookup_rows> sets_;
     std::map<double, std::vector<dvec3>> whole_;
+    ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     double ms_ = 0.0;
 };
 
@@ -158,7 +161,7 @@ void lookup_stage::report(json_writer& j) const {
     j.begin_object();
     j.key("method").value("the lookup at roughness 0.05..1 against the exact LD (ibl::specular_lookup_error): total, "
                           "interpolation part (blend of exact levels), level part (lookup vs that blend); relative RMSE "
-                          "with a floor of 1e-3 x the mean");
+                          "with a floor of 1e-3 x the mean; the exact LD with the chain's LD weight");
     j.key("directions").value(dirs_.size());
     j.key("time_ms").value(ms_);
     j.key("sets").begin_array();

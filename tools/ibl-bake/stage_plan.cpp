@@ -105,6 +105,7 @@ public:
                                ? "irradiance_map"
                                : diffuse_name(ctx.plan.diffuse.kind);
         dfg_layout_ = ctx.opt.dfg_layout;
+        runtime_ = runtime_model_of(ctx.opt, ctx.plan);
     }
 
     std::vector<table_row> rows() const override { return {}; }
@@ -120,6 +121,7 @@ private:
     ibl::plan_cost est_, est_full_;
     std::vector<std::string> omitted_;
     std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_, runtime_diffuse_;
+    runtime_model runtime_;
     int levels_ = 1;
     bool sheen_ = false, mirror_ = false;
     std::string policy_, preset_, dfg_channels_;
@@ -177,7 +179,7 @@ void plan_stage::report(json_writer& j) const {
     j.key("dfg_size").value(plan_.dfg.size);
     j.key("dfg_channels").value(plan_.dfg.channels);
     j.key("sheen").value(sheen_);
-    json_lookup_conventions(j, specular_lookup_named(specular_lookup_), dfg_layout_named(dfg_layout_));
+    json_lookup_conventions(j, specular_lookup_named(specular_lookup_), dfg_layout_named(dfg_layout_), runtime_);
     j.end_object();
     j.key("products");
     plan_json(j, plan_, est_);

@@ -28,7 +28,8 @@ namespace {
 constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 reference texel mean
 
 /// What a loader needs, in the KTX2's key/value data: the level -> roughness mapping, the first
-/// stored level of the virtual chain, the policy, the lookup and the preset.
+/// stored level of the virtual chain, the policy, the lookup, the preset, the chain's LD weight
+/// and the runtime model (lobe: read with lobe_lut.exr; split-sum: with dfg.exr).
 std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_context& ctx) {
     const ibl::specular_plan& sp = ctx.plan.specular;
     std::string r;
@@ -37,9 +38,11 @@ std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_conte
         r.append(fmt("%.9g", l.roughness));
     }
     return {{"ibl.first_level", std::to_string(sp.first_level)},
+            {"ibl.ld_weight", ctx.opt.ld_weight},
             {"ibl.level_roughness", r},
             {"ibl.policy", ctx.opt.policy == "filament" ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r"},
             {"ibl.preset", ctx.opt.preset},
+            {"ibl.runtime", runtime_model_of(ctx.opt, ctx.plan).name},
             {"ibl.specular_lookup", ctx.opt.specular_lookup},
             {"ibl.virtual_levels", std::to_string(sp.virtual_levels)}};
 }
@@ -64,7 +67,8 @@ public:
 
     void run(bake_context& ctx) override {
         ctx.prog.begin("prefilter");
-        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, ctx.ex);
+        weight_ = ld_weight_named(ctx.opt.ld_weight);
+        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex);
         ms_ = ctx.prog.end();
         chain_ = &*ctx.chain;
         sp_ = ctx.plan.specular;
@@ -99,6 +103,7 @@ private:
     std::vector<ktx2_quantisation_level> quant_;
     std::vector<std::pair<std::string, std::string>> metadata_;
     quality_settings qs_{};
+    ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
     std::vector<level_check> checks_;
 };
@@ -122,8 +127,8 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
                 const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size);
                 if (lp.level == 0) ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
                 else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
-                    ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qs_.sky_ref_samples, qs_.sun_cap_nodes);
-                else ref[i] = ibl::reference_ld(env, d, lc.roughness, qs_.ld_ref_samples);
+                    ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qs_.sky_ref_samples, qs_.sun_cap_nodes, weight_);
+                else ref[i] = ibl::reference_ld(env, d, lc.roughness, qs_.ld_ref_samples, weight_);
             }
         });
         return 0;
@@ -137,7 +142,7 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
         const auto& t = texels[i];
         dvec3 got(chain_->texel(t[0], t[1], t[2], k));
         if (sun && lp.level == 0 && ctx.whole_source().size(0) == lc.size) got = dvec3(ctx.whole_source().texel(t[0], t[1], t[2], 0));
-        else if (sun) got += sun_ld(sun, ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size), lc.roughness);
+        else if (sun) got += sun_ld(sun, ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size), lc.roughness, weight_);
         acc.add(got, ref[i]);
     }
     lc.m = acc.finish();
@@ -215,7 +220,9 @@ void specular_stage::report(json_writer& j) const {
     j.key("ktx2_quantisation");
     json_quantisation(j, quant_, format_);
     j.key("method").value(std::string("GGX filtered importance sampling (Krivanek-Colbert), ") +
-                          (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R");
+                          (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
+                          (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
+    j.key("ld_weight").value(weight_ == ibl::ld_weight::g1 ? "g1" : "nl");
     j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? sp_.levels[1].samples : 0u);
     j.key("samples_per_level").begin_array();
     for (const auto& l : sp_.levels) j.value(l.samples);
@@ -225,10 +232,11 @@ void specular_stage::report(json_writer& j) const {
     j.key("virtual_levels").value(sp_.virtual_levels);
     j.key("first_level").value(sp_.first_level);
     j.key("check").begin_object();
-    j.key("reference").value(analytic_ ? "level 0: texel mean (16x16 sub-samples); levels >= 1: ibl::reference_ld_sky "
-                                         "(sky by GGX IS + sun cap quadrature)"
-                                       : "level 0: texel mean (16x16 sub-samples) of the input; levels >= 1: "
-                                         "ibl::reference_ld on the input lat-long map (GGX IS, double)");
+    j.key("reference").value(std::string(analytic_ ? "level 0: texel mean (16x16 sub-samples); levels >= 1: ibl::reference_ld_sky "
+                                                     "(sky by GGX IS + sun cap quadrature)"
+                                                   : "level 0: texel mean (16x16 sub-samples) of the input; levels >= 1: "
+                                                     "ibl::reference_ld on the input lat-long map (GGX IS, double)") +
+                             ", with the chain's LD weight");
     j.key("texels").value("per level: a grid per face plus the 3x3 block around the brightest direction");
     j.key("relative_error_floor").value(floor_);
     j.key("time_ms").value(check_ms_);

@@ -1,9 +1,12 @@
 // tools/ibl-bake/stage_split_sum.cpp — check: what the baked products give through the runtime
-// model. The single-scattering ambient of shade.hpp from the baked chain and DFG table (read by
-// ibl/lookup.hpp's lookups) and the diffuse product, plus an extracted sun as a disk light, against
-// ibl::reference_radiance (MIS of the BRDF and the source's luminance distribution, no split sum)
-// with the same diffuse weighting, for a dielectric and a metal at three roughness values, seen
-// in three views about the brightest direction.
+// model. The single-scattering ambient of shade.hpp from the baked products (the chain read by
+// ibl/lookup.hpp's lookups; with --runtime lobe at the lobe LUT's direction and roughness with its
+// (A, B), else at R and r with the DFG table's) and the diffuse product, plus an extracted sun as a
+// disk light, against ibl::reference_radiance (MIS of the BRDF and the source's luminance
+// distribution, no split sum) with the same diffuse weighting, for a dielectric and a metal at
+// three roughness values, seen in three views about the brightest direction. With the lobe model
+// the plain split sum (LD(R, r) DFG) of the same products is measured too, against the same
+// reference: the report shows both.
 
 #include "stages.hpp"
 
@@ -51,11 +54,22 @@ struct view_result {
     std::string view;
     double n_dot_v, y_ref, y_split, rel, se_rel;
 };
+/// One model's answers for one material and roughness.
+struct model_result {
+    std::vector<view_result> views;
+    double max_abs_rel = 0.0, mean_abs_rel = 0.0;
+
+    void add(const view_result& v, std::size_t count) {
+        views.push_back(v);
+        max_abs_rel = std::max(max_abs_rel, std::fabs(v.rel));
+        mean_abs_rel += std::fabs(v.rel) / double(count);
+    }
+};
 struct split_result {
     std::string material;
     double roughness = 0.0;
-    std::vector<view_result> views;
-    double max_abs_rel = 0.0, mean_abs_rel = 0.0, ms = 0.0;
+    model_result runtime, plain; ///< the runtime model; the plain split sum (the same with --runtime split-sum)
+    double ms = 0.0;
 };
 
 class split_sum_stage final : public stage {
@@ -73,6 +87,7 @@ public:
         const std::vector<view_geom> views = make_views(ctx.light);
         nviews_ = views.size();
         const product_view bp = baked_view(ctx);
+        lobe_ = bp.lobe != nullptr;
         for (const material_case& mc : k_materials)
             for (const double r : k_roughness) {
                 ctx.prog.label(std::string(mc.name) + fmt(" r=%.1f", r));
@@ -88,8 +103,11 @@ private:
     split_result measure(const bake_context& ctx, const ibl::cube_env_distribution& dist, const std::vector<view_geom>& views,
                          const product_view& bp, const material_case& mc, double r) const;
 
+    void report_model(json_writer& j, bool runtime) const;
+
     std::uint32_t samples_ = 0;
     std::size_t nviews_ = 0;
+    bool lobe_ = false;
     std::vector<split_result> results_;
 };
 
@@ -112,12 +130,13 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
     for (const view_geom& g : views) {
         const ibl::radiance_estimate ref = ctx.src.visit(
             [&](const auto& env) { return ibl::reference_radiance<bake_model>(env, dist, g.n, g.v, rm, ro, ctx.ex); });
-        const dvec3 split_lo = bp.shade(shader, g.n, g.v);
-        const double yr = ibl::luminance(ref.value), ys = ibl::luminance(split_lo);
-        const double rel = yr > 0.0 ? ys / yr - 1.0 : 0.0;
-        res.views.push_back({g.name, g.n_dot_v, yr, ys, rel, yr > 0.0 ? ibl::luminance(ref.std_error) / yr : 0.0});
-        res.max_abs_rel = std::max(res.max_abs_rel, std::fabs(rel));
-        res.mean_abs_rel += std::fabs(rel) / double(views.size());
+        const double yr = ibl::luminance(ref.value), se = yr > 0.0 ? ibl::luminance(ref.std_error) / yr : 0.0;
+        auto result = [&](const product_view& pv) {
+            const double ys = ibl::luminance(pv.shade(shader, g.n, g.v));
+            return view_result{g.name, g.n_dot_v, yr, ys, yr > 0.0 ? ys / yr - 1.0 : 0.0, se};
+        };
+        res.runtime.add(result(bp), views.size());
+        res.plain.add(bp.lobe ? result(bp.split_sum()) : res.runtime.views.back(), views.size());
     }
     res.ms = ms_since(t0);
     return res;
@@ -125,30 +144,45 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
 
 std::vector<table_row> split_sum_stage::rows() const {
     std::vector<table_row> rows;
-    for (const auto& res : results_) {
+    auto row = [&](const split_result& res, const model_result& m, bool lobe) {
         double se = 0.0;
-        for (const auto& v : res.views) se = std::max(se, v.se_rel);
-        rows.push_back({"split sum " + res.material + fmt(" r=%.1f", res.roughness), "baked LD+DFG+SH vs MIS reference",
-                        std::to_string(nviews_) + " views x " + std::to_string(samples_) + " spp", res.ms,
-                        fmt2("mean |rel| %.2f%%, max |rel| %.2f%%", 100.0 * res.mean_abs_rel, 100.0 * res.max_abs_rel) +
+        for (const auto& v : m.views) se = std::max(se, v.se_rel);
+        rows.push_back({std::string(lobe ? "lobe lut " : "split sum ") + res.material + fmt(" r=%.1f", res.roughness),
+                        lobe ? "baked LD(lerp(n,R,s), r_eff)+lobe LUT+SH vs MIS" : "baked LD+DFG+SH vs MIS reference",
+                        std::to_string(nviews_) + " views x " + std::to_string(samples_) + " spp", lobe ? -1.0 : res.ms,
+                        fmt2("mean |rel| %.2f%%, max |rel| %.2f%%", 100.0 * m.mean_abs_rel, 100.0 * m.max_abs_rel) +
                             fmt(" (ref se %.2f%%)", 100.0 * se)});
-    }
+    };
+    for (const auto& res : results_) row(res, res.plain, false);
+    if (lobe_)
+        for (const auto& res : results_) row(res, res.runtime, true);
     return rows;
 }
 
 void split_sum_stage::report(json_writer& j) const {
     j.begin_object();
-    j.key("method").value("single-scattering ambient (shade.hpp) from the baked products: chain sampled trilinearly "
-                          "at lod = policy(r), DFG LUT bilinear, SH irradiance; against ibl::reference_radiance "
-                          "(MIS of the BRDF and the source's luminance distribution), same diffuse weighting");
+    j.key("method").value("single-scattering ambient (shade.hpp) from the baked products through the runtime model "
+                          "(runtime_model; lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B, s, r_eff) from the lobe "
+                          "LUT; split-sum: LD at R and r, (A, B) from the DFG LUT), the chain by the bake's lookup, the "
+                          "diffuse product; against ibl::reference_radiance (MIS of the BRDF and the source's luminance "
+                          "distribution), same diffuse weighting. materials: the runtime model; materials_split_sum: "
+                          "the plain split sum of the same products");
+    j.key("runtime_model").value(lobe_ ? "lobe" : "split-sum");
     j.key("samples_per_view").value(samples_);
-    j.key("materials").begin_array();
+    report_model(j, true);
+    report_model(j, false);
+    j.end_object();
+}
+
+void split_sum_stage::report_model(json_writer& j, bool runtime) const {
+    j.key(runtime ? "materials" : "materials_split_sum").begin_array();
     for (const auto& s : results_) {
+        const model_result& m = runtime ? s.runtime : s.plain;
         j.begin_object();
         j.key("material").value(s.material).key("roughness").value(s.roughness);
-        j.key("mean_abs_rel").value(s.mean_abs_rel).key("max_abs_rel").value(s.max_abs_rel).key("time_ms").value(s.ms);
+        j.key("mean_abs_rel").value(m.mean_abs_rel).key("max_abs_rel").value(m.max_abs_rel).key("time_ms").value(s.ms);
         j.key("views").begin_array();
-        for (const auto& v : s.views) {
+        for (const auto& v : m.views) {
             j.begin_object();
             j.key("view").value(v.view).key("n_dot_v").value(v.n_dot_v);
             j.key("luminance_reference").value(v.y_ref).key("luminance_split_sum").value(v.y_split);
@@ -159,7 +193,6 @@ void split_sum_stage::report(json_writer& j) const {
         j.end_object();
     }
     j.end_array();
-    j.end_object();
 }
 
 } // namespace

@@ -10,8 +10,10 @@
 //   irradiance    irradiance cubemap (when the plan chooses a map over SH)
 //   sheen         (--sheen) the Charlie sheen chain and the sheen albedo LUT
 //   dfg           the split-sum DFG table by exact quadrature
+//   lobe_lut      (--runtime lobe) the lobe LUT (A, B, s, r_eff) in the DFG table's layout
 //   lookup        check: the chain where a renderer samples it (between levels), vs exact LD
-//   split_sum     check: the baked products through the runtime model against the full integral
+//   split_sum     check: the baked products through the runtime model (and the plain split
+//                 sum) against the full integral
 //   preview       check: a sphere grid rendered from the baked products
 //   compare_full  check (--scene --compare-full): full and converged bakes, the plan's error
 
@@ -21,6 +23,7 @@
 #include <vector>
 
 #include <ibl/brdf/model.hpp>
+#include <ibl/integrate/ld_weight.hpp>
 #include <ibl/integrate/roughness_mip.hpp>
 #include <ibl/lookup.hpp>
 #include <ibl/shade.hpp>
@@ -37,6 +40,7 @@ std::unique_ptr<stage> make_specular_stage();
 std::unique_ptr<stage> make_sh_stage();
 std::unique_ptr<stage> make_irradiance_stage();
 std::unique_ptr<stage> make_dfg_stage();
+std::unique_ptr<stage> make_lobe_lut_stage();
 std::unique_ptr<stage> make_sheen_stage();
 std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
@@ -59,7 +63,9 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
 /// The products as a renderer samples them (ibl/lookup.hpp): the chain by the lookup `specular`
 /// (its taps over the virtual chain, minus the first stored level, clamped to the stored levels),
 /// the DFG table by ibl::dfg_lookup in its layout (or dfg_exact when there is none), the diffuse
-/// product.
+/// product. The runtime model is the lobe LUT's when `lobe` is set (ibl/runtime.hpp,
+/// specular_lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B) from the lobe LUT, both read in
+/// the DFG table's layout), else the plain split sum (LD at R and r, (A, B) from the DFG table).
 struct product_view {
     const ibl::cubemap<float>* chain = nullptr;
     ibl::roughness_mip_policy policy{};
@@ -69,21 +75,47 @@ struct product_view {
     ibl::specular_lookup_desc specular{};
     ibl::dfg_lut_layout dfg_layout{};
     const ibl::disk_light<double>* sun = nullptr; ///< an extracted sun, added by the shading functions
+    const ibl::lobe_lut* lobe = nullptr;          ///< the lobe LUT: the runtime model is lobe when set
+    ibl::ld_weight weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight (of the sun's LD term)
 
     /// LD at reflection direction r_dir and roughness (the chain only).
     dvec3 ld(const dvec3& r_dir, double roughness) const;
+    /// The products at a shading point through the runtime model (see above).
     ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
+    /// The lobe LUT's (A, B, s, r_eff) at (n.v, r) (ibl::lobe_lut_lookup); needs `lobe`.
+    ibl::vec4<double> lobe_params(double n_dot_v, double roughness) const;
+    /// The same view with the plain split sum as its runtime model.
+    product_view split_sum() const {
+        product_view p = *this;
+        p.lobe = nullptr;
+        return p;
+    }
     /// The runtime model: shader's ambient from the products plus the sun as a disk light.
     dvec3 shade(const ibl::pbr_shader<double>& shader, const dvec3& n, const dvec3& v) const;
     /// E(n) of the runtime (diffuse product plus the sun's cap irradiance), not E/pi.
     dvec3 irradiance(const dvec3& n) const;
 };
 
-/// The DFG table layout and the specular lookup named by --dfg-layout / --specular-lookup.
+/// The DFG table layout, the specular lookup and the LD weight named by --dfg-layout /
+/// --specular-lookup / --ld-weight (g1 | nl).
 ibl::dfg_lut_layout dfg_layout_named(const std::string& name);
 ibl::specular_lookup_desc specular_lookup_named(const std::string& name);
+ibl::ld_weight ld_weight_named(const std::string& name);
+
+/// The runtime model of a bake: "lobe" (with its LUT's size) or "split-sum".
+struct runtime_model {
+    std::string name = "split-sum";
+    int lobe_lut_size = 0;
+    std::string ld_weight = "nl"; ///< the chain's weight: g1 | nl
+};
+/// What the options and the plan give: lobe when --runtime lobe and the plan has a DFG table.
+runtime_model runtime_model_of(const bake_options& o, const ibl::bake_plan& plan);
+/// Texels per side of the lobe LUT: 24, at most the DFG table's (docs/ibl-bake.md, "Lobe LUT").
+int lobe_lut_size_for(int dfg_size);
+
 /// Their description in report.json.
-void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d);
+void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d,
+                             const runtime_model& rm);
 
 /// The products of ctx as a renderer samples them.
 product_view baked_view(const bake_context& ctx);
@@ -91,8 +123,9 @@ product_view baked_view(const bake_context& ctx);
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
 
-/// The sun's LD at direction d and roughness r (its exact term, host quadrature); 0 without one.
-dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness);
+/// The sun's LD at direction d and roughness r for a chain of weight w (its exact term, host
+/// quadrature); 0 without one.
+dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness, ibl::ld_weight w);
 
 /// An extracted sun's term of the Charlie (sheen) LD at R and sheen roughness r: the disk's
 /// radiance x solid angle x D(h_c) (n.l_c) at its centre, over the lobe's normaliser
@@ -118,7 +151,7 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
 
 /// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
 /// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, pool_executor& ex);
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex);
 
 /// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);

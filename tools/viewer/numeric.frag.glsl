@@ -1,5 +1,5 @@
 // tools/viewer/numeric.frag.glsl — evaluates the library's GLSL functions on a fixed grid of
-// inputs: output pixel (i, j) of a 64 x 16 RGBA32F target holds case i of row j. The same grid
+// inputs: output pixel (i, j) of a 64 x 18 RGBA32F target holds case i of row j. The same grid
 // evaluated by the C++ library is tests/browser/glsl_reference.cpp; the two must agree (the
 // inputs are built only from exact operations: multiples of 1/64, small integers).
 
@@ -76,6 +76,14 @@ vec4 row_value(int j, int i) {
         ibl_disk_light sun = ibl_disk_light(l, 6.8e-5, vec3(1.0e4, 2.0e4, 3.0e4));
         ibl_material_terms ms = ibl_resolve_material(ibl_make_material(vec3(0.75, 0.5, 0.25), float(i % 2), 0.25 + 0.75 * x));
         return vec4(ibl_shade_disk(n, v, sun, ms), 0.0);
+    }
+    if (j == 16) { // lerp direction, s in [-0.5, 1.5] (clamped)
+        vec3 a = dir_of(i), b = dir_of(63 - i);
+        return vec4(ibl_lerp_direction(a, b, 2.0 * x - 0.5), 0.0);
+    }
+    if (j == 17) { // the lobe model's direction: R about n = dir_of(i) seen from v = dir_of(63 - i), s = x
+        vec3 a = dir_of(i), b = dir_of(63 - i);
+        return vec4(ibl_lobe_direction(a, b, x), dot(ibl_lobe_direction(a, b, x), a));
     }
     if (j == 12) return vec4(ibl_roughness_from_lod(IBL_MAPPING_FILAMENT, x * 4.0, 4.0), ibl_lod_from_roughness(IBL_MAPPING_FILAMENT, x, 4.0),
                              ibl_dfg_axis_coord(IBL_DFG_AXIS_CBRT, x), ibl_dfg_axis_coord(IBL_DFG_AXIS_SQRT, x));

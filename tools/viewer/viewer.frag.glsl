@@ -3,7 +3,8 @@
 //   u_mode 0  ibl-bake's preview.png, mirrored exactly (tools/ibl-bake/stage_preview.cpp): a 5 x 2
 //             grid of 128-pixel cells, orthographic spheres of radius 0.45 cell, roughness 0.25 i
 //             (column i), dielectric base 0.8 on top, metal (0.95, 0.64, 0.54) below,
-//             multiple-scattering ambient plus the bake's sun (lights.json) as a disk light;
+//             multiple-scattering ambient (the bake's runtime model: the lobe LUT or the split
+//             sum) plus the bake's sun (lights.json) as a disk light;
 //             background = level 0 (the residual) plus the sun's disk, through a 90-degree pinhole;
 //             u_ss x u_ss sub-pixel samples averaged in linear radiance; exposure, Reinhard, sRGB.
 //   u_mode 1  the interactive view: two spheres (dielectric, metal) of one roughness seen through
@@ -12,6 +13,8 @@
 uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
 uniform sampler2D u_lut;
+uniform sampler2D u_lobe;  // the lobe LUT (A, B, s, r_eff) in the DFG layout (u_runtime 1)
+uniform int u_runtime;     // 0 split sum (LD(R, r), DFG), 1 the lobe model (report.json runtime_model)
 uniform vec3 u_sh[9];
 uniform int u_diffuse;     // 0 none, 1 SH, 2 irradiance map
 uniform ivec4 u_spec_levels; // virtual_levels, first_level, stored_levels, mapping
@@ -51,7 +54,9 @@ vec3 diffuse_over_pi(vec3 n) {
 
 vec3 shade_sphere(vec3 n, vec3 v, ibl_material mat) {
     ibl_material_terms m = ibl_resolve_material(mat);
-    ibl_sample s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
+    ibl_sample s; // (WebGL forbids ?: on structures)
+    if (u_runtime == 1) s = ibl_lobe_sample(u_chain, spec_desc(), u_lobe, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
+    else s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     vec3 c = ibl_ambient(m, clamp(dot(n, v), 0.0, 1.0), s, u_spec_rule.z != 0);
     if (u_sun_on != 0) c += ibl_shade_disk(n, v, ibl_disk_light(u_sun_dir, u_sun_solid_angle, u_sun_radiance), m);
     if (dot(u_light_irradiance, u_light_irradiance) > 0.0)

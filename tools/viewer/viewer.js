@@ -15,7 +15,8 @@
 // exposure and camera of the preview), sh.json ("irradiance_over_pi_shader", or its "_windowed" form) or
 // irradiance.ktx2 (texels hold E; used when plan.runtime.diffuse is "irradiance_map"), lights.json
 // (optional: an extracted sun, added back as a disk light; the chain and the diffuse product hold the
-// environment without it).
+// environment without it), lobe_lut.hpp (when plan.runtime.runtime_model.name is "lobe": the lobe
+// LUT, and the spheres are shaded by the lobe model, ibl_lobe_sample; else by the split sum).
 
 import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
 
@@ -58,17 +59,25 @@ function fileSource(files) {
     };
 }
 
-/// The table of dfg.hpp (ibl::dfg_lut_header): size, channels, values row by row.
-export function parseDfgHeader(text) {
-    const size = +(/dfg_lut_size\s*=\s*(\d+)/.exec(text) || [])[1];
-    const channels = +(/dfg_lut_channels\s*=\s*(\d+)/.exec(text) || [])[1];
-    const start = text.indexOf('{', text.search(/dfg_lut\s*\[\s*\d+\s*\]\s*=/));
+/// The table of dfg.hpp (ibl::dfg_lut_header) or lobe_lut.hpp (name 'lobe_lut'): size, channels,
+/// values row by row.
+export function parseDfgHeader(text, name = 'dfg_lut') {
+    const size = +(new RegExp(`${name}_size\\s*=\\s*(\\d+)`).exec(text) || [])[1];
+    const channels = +(new RegExp(`${name}_channels\\s*=\\s*(\\d+)`).exec(text) || [])[1];
+    const start = text.indexOf('{', text.search(new RegExp(`${name}\\s*\\[\\s*\\d+\\s*\\]\\s*=`)));
     const end = text.indexOf('}', start);
-    if (!(size > 0) || !(channels > 0) || start < 0 || end < 0) throw new Error('dfg.hpp: no dfg_lut table');
+    if (!(size > 0) || !(channels > 0) || start < 0 || end < 0) throw new Error(`${name}: no ${name} table`);
     const values = text.slice(start + 1, end).split(',').map((s) => s.trim()).filter((s) => s.length).map(parseFloat);
     if (values.length !== size * size * channels || values.some((v) => !Number.isFinite(v)))
-        throw new Error(`dfg.hpp: ${values.length} values, expected ${size * size * channels}`);
+        throw new Error(`${name}: ${values.length} values, expected ${size * size * channels}`);
     return { size, channels, values: Float32Array.from(values) };
+}
+
+/// The runtime model named by report.json (plan.runtime.runtime_model.name): 'lobe' or 'split-sum'
+/// (bakes without the entry: the split sum).
+function runtimeModelOf(report) {
+    const m = report && report.plan && report.plan.runtime && report.plan.runtime.runtime_model;
+    return m && m.name === 'lobe' ? 'lobe' : 'split-sum';
 }
 
 async function loadBake(src) {
@@ -76,6 +85,8 @@ async function loadBake(src) {
     bake.report = (await src.has('report.json')) ? JSON.parse(await src.text('report.json')) : null;
     bake.sh = (await src.has('sh.json')) ? JSON.parse(await src.text('sh.json')) : null;
     bake.dfg = parseDfgHeader(await src.text('dfg.hpp'));
+    bake.model = runtimeModelOf(bake.report);
+    bake.lobe = bake.model === 'lobe' ? parseDfgHeader(await src.text('lobe_lut.hpp'), 'lobe_lut') : null;
     bake.chain = parseKtx2Cubemap(await src.bytes('specular.ktx2'), 'specular.ktx2');
     bake.irradiance = (await src.has('irradiance.ktx2')) ? parseKtx2Cubemap(await src.bytes('irradiance.ktx2'), 'irradiance.ktx2') : null;
     bake.sun = (await src.has('lights.json')) ? sunOf(JSON.parse(await src.text('lights.json'))) : null;
@@ -232,6 +243,9 @@ class Renderer {
         this.lutTex = lut.tex;
         this.lutFormat = lut.format;
         this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance) : this.chainTex;
+        const lobe = bake.lobe ? uploadLut(gl, bake.lobe, null) : null; // (A, B, s, r_eff): four channels as stored
+        this.lobeTex = lobe ? lobe.tex : this.lutTex;
+        this.lobeFormat = lobe ? lobe.format : null;
         // The renderer's coefficients: the windowed ones when sh.json has them ("radiance" is raw).
         const shc = !bake.sh ? [] : bake.sh.irradiance_over_pi_shader_windowed || bake.sh.irradiance_over_pi_shader || [];
         this.sh = new Float32Array(27);
@@ -263,6 +277,10 @@ class Renderer {
         gl.uniform1i(u('u_chain'), 0);
         gl.uniform1i(u('u_lut'), 1);
         gl.uniform1i(u('u_irradiance'), 2);
+        gl.activeTexture(gl.TEXTURE3);
+        gl.bindTexture(gl.TEXTURE_2D, this.lobeTex);
+        gl.uniform1i(u('u_lobe'), 3);
+        gl.uniform1i(u('u_runtime'), this.bake.model === 'lobe' ? 1 : 0);
         gl.uniform3fv(u('u_sh[0]'), this.sh);
         gl.uniform1i(u('u_diffuse'), rt.diffuse === 'sh' ? 1 : rt.diffuse === 'irradiance_map' && this.bake.irradiance ? 2 : 0);
         const spec = view.lookup === 'textbook' ? { weight: 'lod', interpolation: 'linear' }
@@ -333,6 +351,9 @@ class Renderer {
             irradiance_format: this.bake.irradiance ? this.bake.irradiance.format.name : null,
             sun: this.bake.sun,
             lut_texture: this.lutFormat,
+            runtime_model: this.bake.model,
+            lobe_texture: this.lobeFormat,
+            lobe_size: this.bake.lobe ? this.bake.lobe.size : 0,
             lut_size: this.bake.dfg.size,
             exposure: this.exposure,
             preview_ss: this.previewSs,
@@ -379,7 +400,7 @@ async function runNumericTest() {
     if (!gl) throw new Error('WebGL2 is not available');
     if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to read float results');
     const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('numeric.frag.glsl')));
-    const W = 64, H = 16;
+    const W = 64, H = 18;
     const fb = gl.createFramebuffer(), tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, W, H, 0, gl.RGBA, gl.FLOAT, null);
@@ -453,7 +474,8 @@ async function runViewer() {
             ready = true;
             const i = renderer.info();
             log(`${bake.label}: chain ${i.chain_levels.join('/')} ${i.chain_format}, LUT ${i.lut_size}^2 (${i.lut_texture}), ` +
-                `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, diffuse ${renderer.rt.diffuse}, ` +
+                `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, runtime ${i.runtime_model}` +
+                (i.lobe_size ? ` (lobe LUT ${i.lobe_size}^2)` : '') + `, diffuse ${renderer.rt.diffuse}, ` +
                 `sun ${bake.sun ? bake.sun.solidAngle.toPrecision(3) + ' sr' : 'none'}\n${i.renderer}`);
             redraw();
         } catch (e) {

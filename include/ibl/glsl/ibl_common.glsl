@@ -31,6 +31,11 @@
 //           column 0 the smallest n.v. Axis maps per the table's layout (ibl_dfg_layout):
 //           the bake's default puts texel centres at n.v = (i/(N-1))^3, r = (j/(N-1))^2
 //           (cbrt(n.v) x sqrt(r), edge aligned). Clamp to edge, bilinear.
+// Lobe LUT  the lobe model of ibl/runtime.hpp (ibl-bake --runtime lobe, its default): an N x N
+//           RGBA table in the DFG table's layout and orientation (row 0 = the smallest
+//           roughness), R = A, G = B, B = s (the lerp factor of the lookup direction
+//           normalize(lerp(n, R, s))), A = r_eff (the chain roughness to read there); specular =
+//           LD(d, r_eff) (F0 A + F90 B). Clamp to edge, bilinear (RGBA32F: lobe_lut.hpp's floats).
 // SH        nine shader constants c_k (sh.json "irradiance_over_pi_shader") with
 //           E(n)/pi = sum c_k p_k(n), p = (1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2).
 // Radiance  linear, the units of the source; E/pi is the cosine-weighted mean radiance (a

@@ -1,7 +1,8 @@
 // ibl/glsl/ibl_lookup.glsl — the runtime lookups of the baked products (GLSL mirror of
 // ibl/lookup.hpp and integrate/roughness_mip.hpp): the prefiltered specular chain at any
 // roughness (level taps + blend; the default log-geometric two-level blend and the textbook
-// textureLod), and the DFG table at any (n.v, r) in its layout (dfg_lut_coord). Needs
+// textureLod), the DFG table at any (n.v, r) in its layout (dfg_lut_coord), and the lobe LUT of
+// ibl/runtime.hpp (lobe_lut_lookup, lerp_direction) read in the same layout. Needs
 // ibl_common.glsl first (conventions there).
 
 #ifndef IBL_GLSL_LOOKUP
@@ -205,5 +206,24 @@ vec2 ibl_dfg_lut_coord(float n_dot_v, float roughness, int size, ibl_dfg_layout 
 vec3 ibl_dfg_lookup(sampler2D lut, float n_dot_v, float roughness, ibl_dfg_layout lay) {
     return textureLod(lut, ibl_dfg_lut_coord(n_dot_v, roughness, textureSize(lut, 0).x, lay), 0.0).rgb;
 }
+
+// ---- the lobe LUT (ibl/runtime.hpp: the one-tap lobe model) ----------------------------------------
+
+// normalize(lerp(n, r_dir, s)) for unit n, r_dir, s clamped to [0, 1]; n where the lerp vanishes
+// (lerp_direction).
+vec3 ibl_lerp_direction(vec3 n, vec3 r_dir, float s) {
+    vec3 d = n + ibl_saturate(s) * (r_dir - n);
+    float len2 = dot(d, d);
+    return len2 > IBL_MIN_NORMAL ? d * (1.0 / sqrt(len2)) : n;
+}
+
+// (A, B, s, r_eff) of the lobe LUT at (n.v, r): one bilinear tap in the DFG layout's coordinates
+// (lobe_lut_lookup; the table's layout is the DFG table's, report.json plan.runtime.dfg_layout).
+vec4 ibl_lobe_lut_lookup(sampler2D lut, float n_dot_v, float roughness, ibl_dfg_layout lay) {
+    return textureLod(lut, ibl_dfg_lut_coord(n_dot_v, roughness, textureSize(lut, 0).x, lay), 0.0);
+}
+
+// Where the lobe model reads the chain: normalize(lerp(n, R, s)), R = 2 (n.v) n - v.
+vec3 ibl_lobe_direction(vec3 n, vec3 v, float s) { return ibl_lerp_direction(n, 2.0 * dot(n, v) * n - v, s); }
 
 #endif // IBL_GLSL_LOOKUP

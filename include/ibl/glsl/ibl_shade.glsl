@@ -5,7 +5,8 @@
 // point) and disk lights (a sun: exact cap irradiance, widened-lobe specular). The formulas and
 // their derivations are in shade.hpp's header; every function here is the same expression in the
 // same order. Needs ibl_common.glsl first;
-// ibl_lookup_sample additionally needs ibl_lookup.glsl before this file.
+// ibl_lookup_sample, ibl_lobe_sample and ibl_specular_lobe additionally need ibl_lookup.glsl
+// before this file.
 
 #ifndef IBL_GLSL_SHADE
 #define IBL_GLSL_SHADE 1
@@ -160,6 +161,23 @@ ibl_sample ibl_lookup_sample(samplerCube chain, ibl_specular_desc sd, sampler2D 
     vec3 r_dir = 2.0 * dot(n, v) * n - v;
     vec3 dfg = ibl_dfg_lookup(lut, n_dot_v, roughness, lay);
     return ibl_sample(ibl_specular_lookup(chain, r_dir, roughness, sd), irradiance_over_pi, dfg.xy);
+}
+
+// The products at a shading point through the lobe LUT (ibl/runtime.hpp specular_lobe): with
+// (A, B, s, r_eff) = ibl_lobe_lut_lookup(lobe_lut, n.v, r), LD at normalize(lerp(n, R, s)) and
+// r_eff, (A, B) as the sample's dfg; E/pi passed through. ibl_ambient on it is the lobe model.
+ibl_sample ibl_lobe_sample(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, ibl_dfg_layout lay, vec3 n,
+                           vec3 v, float roughness, vec3 irradiance_over_pi) {
+    vec4 p = ibl_lobe_lut_lookup(lobe_lut, ibl_saturate(dot(n, v)), roughness, lay);
+    vec3 ld = ibl_specular_lookup(chain, ibl_lobe_direction(n, v, p.z), p.w, sd);
+    return ibl_sample(ld, irradiance_over_pi, p.xy);
+}
+
+// The lobe model's specular LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) (specular_lobe).
+vec3 ibl_specular_lobe(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, ibl_dfg_layout lay, vec3 n, vec3 v,
+                       float roughness, vec3 f0, vec3 f90) {
+    ibl_sample s = ibl_lobe_sample(chain, sd, lobe_lut, lay, n, v, roughness, vec3(0.0));
+    return ibl_specular_ibl(s.ld, f0, f90, s.dfg);
 }
 #endif
 

@@ -22,6 +22,10 @@
 //   the direction towards the sun, cos^2(psi - psi_c) >= (cos^2 r - cos^2 gamma) / sin^2 gamma,
 //   where the inner integral vanishes like a square root: psi = psi_c + Delta sin(s) with
 //   Gauss-Legendre in s in [-pi/2, pi/2] removes it. Cost 4 nodes inner integrals.
+//   LD weight (integrate/ld_weight.hpp): with ld_weight::g1 the weight is D(h) G1(R.l), so the
+//   inner integrand cos(rho(u)) becomes G1(cos rho(u)) (no closed form: `nodes` Gauss-Legendre
+//   nodes in u over the interval, 1 - u interpolated between its ends, which are exact in
+//   tau = tan^2(rho/2), so a sharp lobe keeps its resolution) and W is ggx_ld_normaliser_g1.
 // * disk_light_specular_reference(n, v, light, f0, f90, r, nodes): the exact cap integral of the
 //   direct-light specular BRDF of shade.hpp (specular_brdf_direct: GGX D, Schlick-GGX V with
 //   k_direct, Schlick F), integral L f(v, l) max(n.l, 0) dl, by the midpoint rule in polar
@@ -49,8 +53,29 @@
 
 namespace ibl {
 
-/// Integral over the cap of the disk light of D(h) max(R.l, 0) dl (see the header); unit R.
-template <class T> double disk_light_ld_weight(const disk_light<T>& light, const vec3<double>& dir, double roughness, int nodes = 32) {
+namespace detail {
+/// integral of G1(cos rho(u)) du over the u interval of rho in [lo, hi] (the g1 weight's inner
+/// integral, see the header): Gauss-Legendre in u, tau = tan^2(rho/2) = alpha^2 u / (1 - u).
+inline double disk_inner_g1(double lo, double hi, double alpha, const gauss_legendre_rule& gu) {
+    const double a2 = alpha * alpha;
+    const double t0 = sqr(std::tan(0.5 * lo)), t1 = sqr(std::tan(0.5 * hi));
+    const double u0 = t0 / (a2 + t0), u1 = t1 / (a2 + t1), v0 = a2 / (a2 + t0), v1 = a2 / (a2 + t1); // v = 1 - u
+    double s = 0.0;
+    for (std::size_t k = 0; k < gu.x.size(); ++k) {
+        const double x = gu.x[k];
+        const double u = u0 + (u1 - u0) * x, v = v0 + (v1 - v0) * x;
+        const double tau = v > 0.0 ? a2 * u / v : 0.0;
+        s += gu.w[k] * g1_smith_ggx((1.0 - tau) / (1.0 + tau), alpha);
+    }
+    return s * (a2 * (t1 - t0) / ((a2 + t1) * (a2 + t0)));
+}
+} // namespace detail
+
+/// Integral over the cap of the disk light of D(h) k(R.l) dl (see the header; k = max(R.l, 0)
+/// or G1(R.l) by the LD weight); unit R.
+template <class T>
+double disk_light_ld_weight(const disk_light<T>& light, const vec3<double>& dir, double roughness, int nodes = 32,
+                            ld_weight weight = ld_weight::n_dot_l) {
     const int nq = nodes > 0 ? nodes : 1;
     const double alpha = clamp_alpha(alpha_from_roughness(saturate(roughness)));
     const double a2 = alpha * alpha, aq = 1.0 + a2, bq = (1.0 - alpha) * (1.0 + alpha);
@@ -74,6 +99,7 @@ template <class T> double disk_light_ld_weight(const disk_light<T>& light, const
         const double phi0 = std::atan2(B, cos_g), delta = std::acos(std::min(1.0, cos_r / C));
         const double lo = std::max(0.0, phi0 - delta), hi = std::min(half_pi_v<double>, phi0 + delta);
         if (!(hi > lo)) return 0.0;
+        if (weight == ld_weight::g1) return detail::disk_inner_g1(lo, hi, alpha, gu);
         const double u0 = u_of(lo), u1 = u_of(hi);
         if (bq >= 0.5) {
             // closed form in tau = tan^2(rho/2) (u = tau / (alpha^2 + tau)): 1 - b u =
@@ -111,10 +137,14 @@ template <class T> double disk_light_ld_weight(const disk_light<T>& light, const
     return (2.0 / pi_v<double>) * acc.value();
 }
 
-/// The disk light's contribution to LD at unit R and perceptual roughness r (see the header).
-template <class T> vec3<double> disk_light_ld(const disk_light<T>& light, const vec3<double>& dir, double roughness, int nodes = 32) {
+/// The disk light's contribution to LD at unit R and perceptual roughness r (see the header),
+/// for a chain of LD weight w.
+template <class T>
+vec3<double> disk_light_ld(const disk_light<T>& light, const vec3<double>& dir, double roughness, int nodes = 32,
+                           ld_weight weight = ld_weight::n_dot_l) {
     const double alpha = clamp_alpha(alpha_from_roughness(saturate(roughness)));
-    return vec3<double>(light.radiance) * (disk_light_ld_weight(light, dir, roughness, nodes) / ggx_ld_normaliser(alpha));
+    return vec3<double>(light.radiance) *
+           (disk_light_ld_weight(light, dir, roughness, nodes, weight) / ggx_ld_normaliser(alpha, weight));
 }
 
 /// Exact cap integral of L f_spec(v, l) max(n.l, 0) (shade.hpp's specular_brdf_direct); unit n, v.

@@ -28,7 +28,9 @@
 //   LD(R) = sum_t L_t w_t / sum_t w_t,   w_t = Omega_t D(n.h_t) max(c_t, 0),  c_t = R . d_t,
 // with n = v = R, so n.h = |R + d| / 2 and n.h^2 = (1 + c)/2: D depends on the texel only through
 // c. Dividing by the weights' sum (not the closed-form normaliser) makes a constant environment
-// exact. The midpoint rule is accurate when the lobe spans several texels: the lobe of l has an
+// exact. The LD weight of the chain under test (integrate/ld_weight.hpp) is a parameter:
+// ld_weight::g1 multiplies each texel's weight by G1(c_t) / c_t (w_t = Omega_t D G1(c_t)), as
+// the prefilter's G1 samples are weighted. The midpoint rule is accurate when the lobe spans several texels: the lobe of l has an
 // angular half-width of about 2 alpha, and reference_ld_texel_level picks the coarsest level
 // whose texel (pi / (2 n) radians at the face centre) is at most alpha / 2 (ideally 4 or more
 // texels per half-width), level 0 if none is. Comparing two levels bounds its error (the example
@@ -68,6 +70,7 @@
 #include "../sampling/lobe.hpp"
 #include "dfg.hpp"
 #include "dfg_lut.hpp"
+#include "ld_weight.hpp"
 #include "metrics.hpp"
 #include "roughness_mip.hpp"
 
@@ -299,15 +302,17 @@ template <class T> level_texels gather_level_texels(const cubemap<T>& c, int lev
 }
 } // namespace detail
 
-/// Exact LD of cubemap level `level` at each direction (texel-sum quadrature, see the header).
-/// Non-finite texel components read as 0. Work items: directions.
+/// Exact LD of cubemap level `level` at each direction (texel-sum quadrature, see the header)
+/// with the LD weight of the chain it is compared with. Non-finite texel components read as 0.
+/// Work items: directions.
 template <class T, class Executor = serial_executor>
 std::vector<vec3<double>> reference_ld_texel_sum(const cubemap<T>& c, int level, std::span<const vec3<double>> dirs,
-                                                 double roughness, Executor&& ex = Executor{}) {
+                                                 double roughness, Executor&& ex = Executor{},
+                                                 ld_weight weight = ld_weight::n_dot_l) {
     const detail::level_texels tex = detail::gather_level_texels(c, level);
     const std::vector<vec3<double>>&td = tex.dir, &tl = tex.radiance;
     const std::vector<double>& tw = tex.solid_angle;
-    const double a2 = sqr(clamp_alpha(alpha_from_roughness(roughness)));
+    const double alpha = alpha_from_roughness(roughness), a2 = sqr(clamp_alpha(alpha));
     std::vector<vec3<double>> out(dirs.size());
     ex(dirs.size(), [&](std::size_t b, std::size_t e) {
         for (std::size_t i = b; i < e; ++i) {
@@ -319,7 +324,8 @@ std::vector<vec3<double>> reference_ld_texel_sum(const cubemap<T>& c, int level,
                 if (!(cl > 0.0)) continue;
                 const double nh2 = 0.5 * (1.0 + cl);
                 const double den = nh2 * (a2 - 1.0) + 1.0;
-                const double wt = tw[t] * cl * a2 / (pi_v<double> * den * den);
+                const double k = weight == ld_weight::g1 ? g1_smith_ggx(cl, alpha) : cl;
+                const double wt = tw[t] * k * a2 / (pi_v<double> * den * den);
                 s += wt * tl[t];
                 w += wt;
             }

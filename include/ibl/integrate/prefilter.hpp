@@ -96,6 +96,7 @@
 #include "../sampling/ggx.hpp"
 #include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
+#include "ld_weight.hpp"
 #include "roughness_mip.hpp"
 #include "sphere_convolve.hpp"
 
@@ -104,12 +105,6 @@ namespace ibl {
 enum class prefilter_method : int {
     importance = 0,          ///< GGX importance sampling, every sample reads level 0
     filtered_importance = 1, ///< Krivanek-Colbert filtered importance sampling
-};
-
-/// The per-sample weight of the LD integral (header: "LD weight").
-enum class ld_weight : int {
-    n_dot_l = 0, ///< Karis 2013: D(h) n.l
-    g1 = 1,      ///< D(h) G1(n.l): the specular lobe at n.v = 1
 };
 
 struct prefilter_options {

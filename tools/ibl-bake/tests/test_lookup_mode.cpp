@@ -1,10 +1,12 @@
 // tools/ibl-bake/tests/test_lookup_mode.cpp — `ibl-bake --lookup DIR` answers as the library's
 // runtime functions do on the files of DIR. A tiny bake is made; the test loads its files itself
 // (specular.ktx2 decoded to an ibl::cubemap, dfg.exr to an ibl::dfg_lut, sh.json's shader
-// coefficients) and evaluates ibl::specular_lookup, ibl::dfg_lookup, ibl::sh_shader_evaluate and
-// pbr_shader::ambient (multiple scattering) at the same queries; every answer must agree to float
-// precision (relative 2e-6, about 16 float ulps: the answers are printed with 9 digits). Malformed
-// queries get an error line each and exit status 1; comments and blank lines get no answer.
+// coefficients, lobe_lut.exr) and evaluates ibl::specular_lookup, ibl::dfg_lookup,
+// ibl::sh_shader_evaluate, ibl::lobe_lut_lookup and pbr_shader::ambient (multiple scattering) on
+// the bake's runtime model (the default: ibl::specular_lobe; split-sum: LD(R, r) DFG) at the
+// same queries; every answer must agree to float precision (relative 2e-6, about 16 float ulps:
+// the answers are printed with 9 digits). Malformed queries get an error line each and exit
+// status 1; comments and blank lines get no answer.
 
 #include <doctest/doctest.h>
 
@@ -29,7 +31,9 @@
 
 #include <ibl/integrate/dfg_lut.hpp>
 #include <ibl/integrate/disk_light.hpp>
+#include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/lookup.hpp>
+#include <ibl/runtime.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/shade.hpp>
 
@@ -58,6 +62,23 @@ ibl::dfg_lut load_lut(const std::string& path) {
         for (int i = 0; i < img.width; ++i)
             for (int c = 0; c < 3; ++c) lut.data.push_back(img.texel(i, j)[c]);
     return lut;
+}
+
+ibl::lobe_lut load_lobe(const std::string& path) {
+    const image_rgba32f img = read_exr_rgba(path);
+    ibl::lobe_lut lut;
+    lut.size = std::uint32_t(img.width);
+    lut.data = img.rgba;
+    return lut;
+}
+
+/// LD of the lobe model at (n, v, r): ibl::specular_lobe with F0 = F90 = 1 gives LD (A + B).
+dvec3 lobe_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const dvec3& n, const dvec3& v, double r) {
+    const ibl::dfg_lut_layout layout{};
+    const fvec3 fn(n), fv(v);
+    const ibl::vec4<float> p = ibl::lobe_lut_lookup(lobe, ibl::saturate(glm::dot(fn, fv)), float(r), layout);
+    const fvec3 e = ibl::specular_lobe(chain, ibl::specular_lookup_desc{}, lobe, layout, fn, fv, float(r), fvec3(1.0f), fvec3(1.0f));
+    return dvec3(e) / double(ibl::saturate(p.x) + ibl::saturate(p.y));
 }
 
 ibl::sh_coeffs<double, 3> load_sh(const std::string& path) {
@@ -109,6 +130,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
     const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
     const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
     const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
+    const ibl::lobe_lut lobe = load_lobe(s / "bake/lobe_lut.exr"); // the default runtime model
     const ibl::specular_lookup_desc sd{};
     const ibl::dfg_lut_layout layout{};
 
@@ -142,12 +164,16 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         m.base_color = dvec3(0.9, 0.6, 0.5);
         ibl::ibl_sample<double> smp;
         const double ndv = std::clamp(glm::dot(d, v), 0.0, 1.0);
-        smp.ld = dvec3(ibl::specular_lookup(chain, fvec3(2.0 * glm::dot(d, v) * d - v), float(r), sd));
-        const fvec3 ab2 = ibl::dfg_lookup(lut, float(ndv), float(r), layout);
-        smp.dfg = ibl::vec2<double>(ab2.x, ab2.y);
+        const ibl::vec4<float> pv = ibl::lobe_lut_lookup(lobe, float(ndv), float(r), layout);
+        smp.ld = lobe_ld(chain, lobe, d, v, r);
+        smp.dfg = ibl::vec2<double>(pv.x, pv.y);
         smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, d), dvec3(0.0));
         const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
         want.push_back({lo.x, lo.y, lo.z});
+        std::snprintf(buf, sizeof buf, "lobe %.17g %.17g", nv, r);
+        q.push_back(buf);
+        const ibl::vec4<float> pl = ibl::lobe_lut_lookup(lobe, float(nv), float(r), layout);
+        want.push_back({pl.x, pl.y, pl.z, pl.w});
     }
     std::ofstream(s / "queries.txt") << "# a comment\n\n" << [&] {
         std::string all;
@@ -166,6 +192,43 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
     CHECK(bad.find("error: line 4: the normal is zero") != std::string::npos);
     CHECK(std::count(bad.begin(), bad.end(), '\n') == 5); // one line per query, the last one answered
     CHECK(shell(tool + " --lookup " + (s / "nothing") + " < /dev/null > /dev/null 2>&1") == 1);
+}
+
+TEST_CASE("lookup: a split-sum bake shades with LD(R, r) and the DFG table, and has no lobe answers") {
+    scratch s("ibl_bake_lookup_split");
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --runtime split-sum --out " +
+                  (s / "bake") + " >/dev/null 2>&1") == 0);
+    CHECK_FALSE(fs::exists(s / "bake/lobe_lut.exr"));
+    const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
+    const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
+    const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
+    std::string q;
+    std::vector<std::vector<double>> want;
+    for (int k = 0; k < 12; ++k) {
+        const dvec3 n = glm::normalize(dvec3(std::sin(0.7 * k), 0.5, std::cos(0.3 * k))), v = glm::normalize(n + dvec3(0.4, 0.2, -0.3));
+        const double r = std::fmod(0.083 * k + 0.01, 1.0);
+        char buf[256];
+        std::snprintf(buf, sizeof buf, "shade %.17g %.17g %.17g %.17g %.17g %.17g %.17g 1 0.9 0.6 0.5\n", n.x, n.y, n.z, v.x, v.y, v.z, r);
+        q += buf;
+        ibl::pbr_material<double> m;
+        m.roughness = r;
+        m.metallic = 1.0;
+        m.base_color = dvec3(0.9, 0.6, 0.5);
+        const double ndv = std::clamp(glm::dot(n, v), 0.0, 1.0);
+        ibl::ibl_sample<double> smp;
+        smp.ld = dvec3(ibl::specular_lookup(chain, fvec3(2.0 * glm::dot(n, v) * n - v), float(r)));
+        const fvec3 ab = ibl::dfg_lookup(lut, float(ndv), float(r), ibl::dfg_lut_layout{});
+        smp.dfg = ibl::vec2<double>(ab.x, ab.y);
+        smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, n), dvec3(0.0));
+        const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
+        want.push_back({lo.x, lo.y, lo.z});
+    }
+    std::ofstream(s / "q.txt") << q;
+    REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
+    check_answers(slurp(s / "a.txt"), want);
+    std::ofstream(s / "q2.txt") << "lobe 0.5 0.5\n";
+    CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
+    CHECK(slurp(s / "a2.txt").find("no lobe LUT") != std::string::npos);
 }
 
 TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers are about the whole environment") {
@@ -190,7 +253,8 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
             char buf[200];
             std::snprintf(buf, sizeof buf, "specular %.17g %.17g %.17g %.17g\nirradiance %.17g %.17g %.17g\n", d.x, d.y, d.z, r, d.x, d.y, d.z);
             q += buf;
-            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r))) + ibl::disk_light_ld(sun, d, r);
+            // the chain is G1-weighted: the sun's term of the same weight (the tool's 8 nodes)
+            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r))) + ibl::disk_light_ld(sun, d, r, 8, ibl::ld_weight::g1);
             const dvec3 e = dvec3(map.radiance(fvec3(d), 0.0f)) + ibl::disk_light_irradiance(d, sun);
             want.push_back({ld.x, ld.y, ld.z});
             want.push_back({e.x, e.y, e.z});

@@ -43,8 +43,8 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     const std::string base = tool + " --quiet --size 32 --quality low --lut-size 32 ";
     REQUIRE(shell(base + "--preset filament --out " + (s / "fil") + " >/dev/null") == 0);
     REQUIRE(shell(base + "--preset gltf --out " + (s / "gltf") + " >/dev/null") == 0);
-    REQUIRE(shell(base + "--dfg-layout uniform --specular-lookup textbook --extract-sun off --irradiance-size 0 --out " + (s / "ref") +
-               " >/dev/null") == 0);
+    REQUIRE(shell(base + "--dfg-layout uniform --specular-lookup textbook --extract-sun off --irradiance-size 0 --ld-weight nl "
+                         "--runtime split-sum --out " + (s / "ref") + " >/dev/null") == 0);
     const auto fil = ibl_examples::parse_json(slurp(s / "fil/report.json"));
     const auto ref = ibl_examples::parse_json(slurp(s / "ref/report.json"));
     // mirror: the brightest direction's x flips, y and z stay
@@ -79,6 +79,12 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     const ktx2_info info = parse_ktx2(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(k.data()), k.size()));
     std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
     CHECK(kv["ibl.preset"] == "filament");
+    CHECK(kv["ibl.ld_weight"] == "nl"); // the engines' n.l chain and split sum
+    CHECK(kv["ibl.runtime"] == "split-sum");
+    CHECK(fil.find("plan")->find("runtime")->find("runtime_model")->find("name")->string == "split-sum");
+    CHECK(fil.find("plan")->find("runtime")->find("ld_weight")->find("name")->string == "nl");
+    CHECK_FALSE(fs::exists(s / "fil/lobe_lut.exr"));
+    CHECK_FALSE(fs::exists(s / "gltf/lobe_lut.exr"));
     CHECK(kv["ibl.first_level"] == "0");
     CHECK(kv["ibl.virtual_levels"] == "4");
     CHECK(kv["ibl.policy"].rfind("filament", 0) == 0);

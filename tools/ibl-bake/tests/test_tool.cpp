@@ -252,6 +252,25 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     CHECK(rep["sh"]["check"]["max_rel"].kind == json::number_v);
     CHECK(rep["dfg"]["check"]["max_abs"].number < 1e-2);
     CHECK(rep["split_sum"]["materials"].items.size() == 6);
+    // the default runtime model: the lobe LUT of a G1 chain, both models measured
+    CHECK(r.out.find("lobe lut metal r=0.9") != std::string::npos);
+    CHECK(rep["split_sum"]["runtime_model"].str == "lobe");
+    CHECK(rep["split_sum"]["materials_split_sum"].items.size() == 6);
+    CHECK(rep["plan"]["runtime"]["runtime_model"]["name"].str == "lobe");
+    CHECK(rep["plan"]["runtime"]["ld_weight"]["name"].str == "g1");
+    CHECK(rep["lobe_lut"]["size"].number == 16); // at most the DFG table's size
+    CHECK(rep["lobe_lut"]["weight"].str == "g1");
+    // its (A, B) is the DFG table's, up to the table's interpolation at the small-roughness rows
+    CHECK(rep["lobe_lut"]["check"]["ab_vs_dfg_max_abs"].number < 5e-2);
+    const image_rgba32f lobe = read_exr_rgba(out + "/lobe_lut.exr");
+    CHECK(lobe.width == 16);
+    REQUIRE(lobe.rgba.size() == 16 * 16 * 4);
+    CHECK(lobe.rgba[2] == 1.0f); // row 0 = r = 0 (edge-aligned): the mirror, s = 1, r_eff = 0
+    CHECK(lobe.rgba[3] == 0.0f);
+    CHECK(slurp(out + "/lobe_lut.hpp").find("lobe_lut_size = 16;") != std::string::npos);
+    const std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
+    CHECK(kv.at("ibl.ld_weight") == "g1");
+    CHECK(kv.at("ibl.runtime") == "lobe");
     // nothing else in the parent: the staging directory is gone
     CHECK(entries(s.path) == std::set<std::string>{"bake", "stderr.txt", "stdout.txt"});
 }
@@ -270,7 +289,7 @@ TEST_CASE("deterministic: bit-identical outputs with 1 and 2 threads") {
         CHECK(slurp(a + "/" + f) == slurp(b + "/" + f));
         ++compared;
     }
-    CHECK(compared == 18 + 5 + 8); // + irradiance_{face}.exr, irradiance.ktx2, lights.json
+    CHECK(compared == 18 + 5 + 8 + 2); // + irradiance_{face}.exr, irradiance.ktx2, lights.json, lobe_lut.{exr,hpp}
 }
 
 TEST_CASE("bad options: exit 2 with a message, nothing created") {
@@ -286,6 +305,8 @@ TEST_CASE("bad options: exit 2 with a message, nothing created") {
         {"--out", out, "--lut-size", "0"},
         {"--out", out, "--threads", "-1"},
         {"--out", out, "--quality", "ultra"},
+        {"--out", out, "--ld-weight", "g2"},
+        {"--out", out, "--runtime", "lobes"},
         {"--out", out, "--levels", "9", "--size", "16"},
         {"--size", "16"},
         {"stray", "--out", out},
