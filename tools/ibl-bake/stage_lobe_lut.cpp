@@ -1,12 +1,13 @@
 // tools/ibl-bake/stage_lobe_lut.cpp — the lobe LUT of the runtime model (--runtime lobe;
-// ibl/runtime.hpp, integrate/lobe_lut.hpp): per (n.v, r) the DFG terms A, B, the lerp factor s of
-// the lobe's mean direction and the chain roughness r_eff whose LD kernel (of the chain's weight)
-// has the lobe's spread, in the DFG table's layout at lobe_lut_size_for(DFG size) texels per side.
-// The table is smooth and its build matches r_eff by bisection per texel (about 0.5 ms a texel
-// and thread: 24^2 takes about 0.25 s on 2 cores, the DFG table's 128^2 about a minute).
-// Checks: (A, B) against the DFG table read (ibl::dfg_lookup) at the lobe LUT's texels; s and
-// r_eff read bilinearly (ibl::lobe_lut_lookup) at the midpoints of every second cell per axis
-// against the direct moments (ibl::specular_lobe_moments + ibl::ld_matched_roughness).
+// ibl/runtime.hpp, integrate/lobe_fit.hpp): per (n.v, r) the DFG terms A, B, the lerp factor s
+// and the chain roughness r_eff of the one chain kernel closest to the specular lobe in L1
+// (ibl::make_lobe_lut_fitted, the chain's weight), in the DFG table's layout at
+// lobe_lut_size_for(DFG size) texels per side. The fit marches each row from n.v = 1 with the
+// neighbour's answer as its start (about 0.5 ms a texel and thread).
+// Checks: (A, B) against the DFG table read (ibl::dfg_lookup) at the lobe LUT's texels; at the
+// midpoints of every second cell per axis, the L1 distance to the lobe of the tap read bilinearly
+// (ibl::lobe_lut_lookup) against that of a direct fit there (what the table's interpolation
+// costs) and of the one-tap moment match (ibl::specular_lobe_moments, what the fit gains).
 // Files: lobe_lut.exr (RGBA float32; rows as dfg.exr: row 0 = the smallest roughness; R = A,
 // G = B, B = s, A = r_eff) and lobe_lut.hpp (the same floats as a C header, read by the viewer).
 
@@ -16,18 +17,20 @@
 #include <cmath>
 #include <sstream>
 
-#include <ibl/integrate/lobe_lut.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/runtime.hpp>
 
 namespace ibl_bake {
 
 namespace {
 
-constexpr std::uint32_t lobe_nodes = 96; ///< nodes^2 VNDF points per texel (make_lobe_lut's default)
-constexpr std::uint32_t cell_stride = 2; ///< midpoint check: every second cell per axis
+constexpr std::uint32_t check_nodes = 32; ///< nodes^2 lobe points of the midpoint check's L1 distances
+constexpr std::uint32_t cell_stride = 2;  ///< midpoint check: every second cell per axis
 
-struct midpoint_error {
-    double max_abs = 0.0, rms = 0.0, worst_n_dot_v = 0.0, worst_roughness = 0.0;
+/// L1 distances at the midpoints: of the table's tap, of a direct fit, of the moment match.
+struct midpoint_l1 {
+    double table_mean = 0.0, fit_mean = 0.0, moments_mean = 0.0;
+    double excess_max = 0.0, worst_n_dot_v = 0.0, worst_roughness = 0.0;
 };
 
 /// The table as a C header (the layout of dfg.hpp: name_size, name_channels, name[] row by row).
@@ -70,7 +73,7 @@ public:
         weight_ = ld_weight_named(ctx.opt.ld_weight);
         const auto size = std::uint32_t(lobe_lut_size_for(ctx.plan.dfg.size));
         ctx.prog.begin("lobe lut");
-        ctx.lobe = ibl::make_lobe_lut<bake_model>(size, layout_, weight_, lobe_nodes, ctx.ex);
+        ctx.lobe = ibl::make_lobe_lut_fitted<bake_model>(size, layout_, weight_, ibl::lobe_fit_options{}, ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lobe;
         ctx.prog.begin("check lobe lut");
@@ -80,10 +83,12 @@ public:
     }
 
     std::vector<table_row> rows() const override {
-        return {{"lobe lut", std::string("lobe moments, ") + bake_model::name + ", chain weight " + weight_name_,
-                 std::to_string(lut_->size) + "^2, " + std::to_string(lobe_nodes) + "^2 points/texel", ms_,
-                 fmt("A,B vs dfg max abs %.3g", ab_max_abs_) + fmt2("; midpoints: s %.3g, r_eff %.3g", s_.max_abs, r_eff_.max_abs) +
-                     fmt2(" (rms %.3g, %.3g)", s_.rms, r_eff_.rms)}};
+        const ibl::lobe_fit_options o;
+        return {{"lobe lut", std::string("L1 fit of one kernel, ") + bake_model::name + ", chain weight " + weight_name_,
+                 std::to_string(lut_->size) + "^2, " + std::to_string(o.nodes) + "^2 points/texel", ms_,
+                 fmt("A,B vs dfg max abs %.3g", ab_max_abs_) +
+                     fmt2("; midpoint L1 table %.3g, direct fit %.3g", l1_.table_mean, l1_.fit_mean) +
+                     fmt(", moments %.3g", l1_.moments_mean)}};
     }
     std::vector<file_out> files() const override;
     void report(json_writer& j) const override;
@@ -111,39 +116,46 @@ private:
     std::string weight_name_;
     double ms_ = 0.0, check_ms_ = 0.0, ab_max_abs_ = 0.0;
     std::size_t cells_ = 0;
-    midpoint_error s_, r_eff_;
+    midpoint_l1 l1_;
 };
+
+/// The one tap (angle from n towards R, roughness) a lobe LUT read (s, r_eff) stands for at n.v.
+ibl::lobe_tap tap_of(double n_dot_v, double s, double r_eff) {
+    const double th = std::acos(std::clamp(n_dot_v, 0.0, 1.0));
+    return {std::atan2(s * std::sin(th), 1.0 + s * (std::cos(th) - 1.0)), r_eff, 1.0};
+}
 
 void lobe_lut_stage::check_midpoints(pool_executor& ex) {
     const std::uint32_t n = lut_->size;
-    std::vector<std::array<double, 4>> pts; // n.v, r, error of s, error of r_eff
+    std::vector<std::array<double, 5>> pts; // n.v, r, L1 of the table's tap, of a direct fit, of the moments
     for (std::uint32_t j = 0; j + 1 < n; j += cell_stride)
         for (std::uint32_t i = 0; i + 1 < n; i += cell_stride) {
             const auto mid = [&](ibl::dfg_axis a, std::uint32_t k) {
                 return ibl::dfg_axis_value(a, 0.5 * (ibl::dfg_texel_coord<double>(k, n, layout_.edge_aligned) +
                                                      ibl::dfg_texel_coord<double>(k + 1, n, layout_.edge_aligned)));
             };
-            pts.push_back({mid(layout_.n_dot_v, i), mid(layout_.roughness, j), 0.0, 0.0});
+            const double nv = mid(layout_.n_dot_v, i), r = mid(layout_.roughness, j);
+            if (r >= 0.05 && nv >= 1e-3) pts.push_back({nv, r, 0.0, 0.0, 0.0}); // as the fit's statistics
         }
     ex(pts.size(), [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const double nv = pts[k][0], r = pts[k][1];
             const ibl::vec4<float> p = ibl::lobe_lut_lookup(*lut_, float(nv), float(r), layout_);
-            const ibl::lobe_moments m = ibl::specular_lobe_moments<bake_model>(std::min(nv, std::cos(ibl::lobe_min_theta)), r, lobe_nodes);
-            pts[k][2] = std::fabs(double(p.z) - m.lerp);
-            pts[k][3] = std::fabs(double(p.w) - ibl::ld_matched_roughness(m.rho, weight_));
+            const ibl::detail::lobe_points lp = ibl::detail::make_lobe_points<bake_model>(nv, r, check_nodes);
+            std::array<ibl::lobe_tap, ibl::lobe_max_taps> t{};
+            t[0] = tap_of(nv, p.z, p.w);
+            pts[k][2] = ibl::detail::mixture_l1(lp, t, 1, weight_, {});
+            const ibl::lobe_mixture f = ibl::fit_specular_lobe<bake_model>(nv, r, weight_);
+            pts[k][3] = ibl::detail::mixture_l1(lp, f.taps, 1, weight_, {});
+            pts[k][4] = f.l1_moments;
         }
     });
-    auto summarise = [&](int c, midpoint_error& out) {
-        double sq = 0.0;
-        for (const auto& p : pts) {
-            sq += p[std::size_t(c)] * p[std::size_t(c)];
-            if (p[std::size_t(c)] > out.max_abs) out = {p[std::size_t(c)], 0.0, p[0], p[1]};
-        }
-        out.rms = pts.empty() ? 0.0 : std::sqrt(sq / double(pts.size()));
-    };
-    summarise(2, s_);
-    summarise(3, r_eff_);
+    for (const auto& p : pts) {
+        l1_.table_mean += p[2] / double(pts.size());
+        l1_.fit_mean += p[3] / double(pts.size());
+        l1_.moments_mean += p[4] / double(pts.size());
+        if (p[2] - p[3] > l1_.excess_max) l1_.excess_max = p[2] - p[3], l1_.worst_n_dot_v = p[0], l1_.worst_roughness = p[1];
+    }
     cells_ = pts.size();
 }
 
@@ -165,20 +177,21 @@ void lobe_lut_stage::report(json_writer& j) const {
                           "); EXR row 0 (top) = the smallest roughness");
     j.key("weight").value(weight_name_);
     j.key("channels").value("R = A, G = B (the DFG terms), B = s (lerp factor: d = normalize(lerp(n, R, s))), A = r_eff (the chain's roughness)");
-    j.key("method").value("ibl::make_lobe_lut: A, B by ibl::make_dfg_lut_exact; s, r_eff from the lobe's first moment "
-                          "(ibl::specular_lobe_moments, " + std::to_string(lobe_nodes) + "^2 VNDF points) and ibl::ld_matched_roughness");
+    j.key("method").value("ibl::make_lobe_lut_fitted: A, B by ibl::make_dfg_lut_exact; s, r_eff of the one chain kernel "
+                          "closest to the normalised specular lobe in L1 (ibl::fit_specular_lobe, " +
+                          std::to_string(ibl::lobe_fit_options{}.nodes) + "^2 lobe points, Nelder-Mead)");
     j.key("time_ms").value(ms_);
     j.key("check").begin_object();
     j.key("ab_vs_dfg_max_abs").value(ab_max_abs_);
     j.key("midpoints").value(cells_);
-    auto err = [&](const char* k, const midpoint_error& e) {
-        j.key(k).begin_object().key("max_abs").value(e.max_abs).key("rms").value(e.rms);
-        j.key("worst_n_dot_v").value(e.worst_n_dot_v).key("worst_roughness").value(e.worst_roughness).end_object();
-    };
-    err("s", s_);
-    err("r_eff", r_eff_);
-    j.key("method").value("A, B against ibl::dfg_lookup of the DFG table at the lobe LUT's texels; s and r_eff by "
-                          "ibl::lobe_lut_lookup at the midpoints of every second cell per axis against the direct moments");
+    j.key("l1").begin_object();
+    j.key("table_mean").value(l1_.table_mean).key("direct_fit_mean").value(l1_.fit_mean).key("moments_mean").value(l1_.moments_mean);
+    j.key("excess_max").value(l1_.excess_max).key("worst_n_dot_v").value(l1_.worst_n_dot_v);
+    j.key("worst_roughness").value(l1_.worst_roughness).end_object();
+    j.key("method").value("A, B against ibl::dfg_lookup of the DFG table at the lobe LUT's texels; at the midpoints of every "
+                          "second cell per axis (r >= 0.05) the L1 distance to the lobe (" + std::to_string(check_nodes) +
+                          "^2 points; 2 = disjoint) of the tap read by ibl::lobe_lut_lookup, of a direct fit there, and of "
+                          "the one-tap moment match");
     j.key("time_ms").value(check_ms_);
     j.end_object();
     j.end_object();
