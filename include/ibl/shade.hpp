@@ -83,7 +83,12 @@
 //   terms; atan u - u by its series below u = 1/4). Continuous at both ends of the band; at
 //   theta = pi/2 it is r - sin r cos r (half the cap).
 //   Specular, cheap: the GGX lobe widened by the cap, evaluated at the cap centre d:
-//       f = D(n.h; alpha') V(n.v, n.l; k_direct(r)) F(v.h),  h = normalize(v + d),
+//       f = D(n.h; alpha') V(n.v, n.l; alpha) F(v.h),  h = normalize(v + d),
+//   V the height-correlated Smith visibility (v_smith_ggx_correlated), the model of the DFG
+//   table and of every reference: a disk light is a part of the environment (an extracted sun),
+//   so it is shaded by the BRDF the image-based products assume, not by the punctual lights'
+//   Schlick-GGX k_direct convention (that remap made the sun's glint 15-33% darker than the
+//   full integral of the environment for a metal at r = 0.5).
 //       alpha'^2 = alpha^2 + tan^2(r/2) / max(v.h, 1/20),   tan^2(r/2) = (1 - cos r)/(1 + cos r)
 //       L_o = f E_perp n.d,  E_perp = L pi sin^2 r.
 //   Derivation: the cap seen through the half vector is an ellipse of semi-axes r/2 (in the plane
@@ -426,7 +431,7 @@ IBL_FUNC vec3<T> disk_light_specular(const vec3<T>& n, const vec3<T>& v, const d
     const T vh = c.v_dot_h > T(0.05) ? c.v_dot_h : T(0.05);
     const T alpha_w = sqrt(sqr(clamp_alpha(alpha_from_roughness(r))) + tan2_half / vh);
     const T d = ndf_ggx(c.n_dot_h, alpha_w < T(1) ? alpha_w : T(1));
-    const T vis = v_smith_schlick_ggx(saturate(glm::dot(n, v)), c.n_dot_l, k_direct(r));
+    const T vis = v_smith_ggx_correlated(saturate(glm::dot(n, v)), c.n_dot_l, clamp_alpha(alpha_from_roughness(r)));
     return (d * vis * c.n_dot_l) * fresnel_schlick(c.v_dot_h, f0, f90) * disk_light_normal_irradiance(light);
 }
 

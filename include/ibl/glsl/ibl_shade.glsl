@@ -211,6 +211,18 @@ float ibl_k_direct(float roughness) {
     return (r + 1.0) * (r + 1.0) / 8.0;
 }
 
+// Height-correlated Smith visibility G2 / (4 n.v n.l) for GGX (the image-based products' model):
+// 0.5 / (n.l sqrt(n.v^2 + a^2 (1 - n.v^2)) + n.v sqrt(n.l^2 + a^2 (1 - n.l^2))), the denominator
+// floored at IBL_MIN_NORMAL (finite at the corner n.v = n.l = 0).
+float ibl_v_smith_ggx_correlated(float n_dot_v, float n_dot_l, float alpha) {
+    float a = clamp(alpha, IBL_GGX_MIN_ALPHA, 1.0);
+    float a2 = a * a;
+    float mv = ibl_saturate(n_dot_v), ml = ibl_saturate(n_dot_l);
+    float den = ml * sqrt(max(mv * mv + a2 * (1.0 - mv) * (1.0 + mv), 0.0)) +
+                mv * sqrt(max(ml * ml + a2 * (1.0 - ml) * (1.0 + ml), 0.0));
+    return 0.5 / max(den, IBL_MIN_NORMAL);
+}
+
 // Schlick-GGX visibility G / (4 n.v n.l) with the cosines cancelled: 1 / (4 dv dl).
 float ibl_v_smith_schlick_ggx(float n_dot_v, float n_dot_l, float k) {
     float kc = clamp(k, IBL_SCHLICK_MIN_K, 1.0);
@@ -324,7 +336,7 @@ vec3 ibl_disk_light_specular(vec3 n, vec3 v, ibl_disk_light light, vec3 f0, vec3
     float a = clamp(r * r, IBL_GGX_MIN_ALPHA, 1.0);
     float alpha_w = sqrt(a * a + tan2_half / vh);
     float d = ibl_ndf_ggx(c.n_dot_h, alpha_w < 1.0 ? alpha_w : 1.0);
-    float vis = ibl_v_smith_schlick_ggx(ibl_saturate(dot(n, v)), c.n_dot_l, ibl_k_direct(r));
+    float vis = ibl_v_smith_ggx_correlated(ibl_saturate(dot(n, v)), c.n_dot_l, a);
     return (d * vis * c.n_dot_l) * ibl_fresnel_schlick(c.v_dot_h, f0, f90) * ibl_disk_light_normal_irradiance(light);
 }
 

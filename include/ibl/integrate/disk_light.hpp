@@ -27,8 +27,8 @@
 //   nodes in u over the interval, 1 - u interpolated between its ends, which are exact in
 //   tau = tan^2(rho/2), so a sharp lobe keeps its resolution) and W is ggx_ld_normaliser_g1.
 // * disk_light_specular_reference(n, v, light, f0, f90, r, nodes): the exact cap integral of the
-//   direct-light specular BRDF of shade.hpp (specular_brdf_direct: GGX D, Schlick-GGX V with
-//   k_direct, Schlick F), integral L f(v, l) max(n.l, 0) dl, by the midpoint rule in polar
+//   disk light's specular BRDF of shade.hpp (GGX D, height-correlated Smith V, Schlick F: the
+//   image-based products' model), integral L f(v, l) max(n.l, 0) dl, by the midpoint rule in polar
 //   coordinates about the disk centre (nodes radial x 4 nodes azimuthal): the reference that
 //   disk_light_specular (the widened lobe of shade.hpp) is measured against.
 // * disk_light_irradiance_reference(n, light, nodes): integral L max(n.l, 0) dl over the cap by
@@ -147,7 +147,7 @@ vec3<double> disk_light_ld(const disk_light<T>& light, const vec3<double>& dir, 
            (disk_light_ld_weight(light, dir, roughness, nodes, weight) / ggx_ld_normaliser(alpha, weight));
 }
 
-/// Exact cap integral of L f_spec(v, l) max(n.l, 0) (shade.hpp's specular_brdf_direct); unit n, v.
+/// Exact cap integral of L f_spec(v, l) max(n.l, 0) (GGX D, height-correlated V, Schlick F); unit n, v.
 template <class T>
 vec3<double> disk_light_specular_reference(const vec3<double>& n, const vec3<double>& v, const disk_light<T>& light,
                                            const vec3<double>& f0, const vec3<double>& f90, double roughness, int nodes = 256) {
@@ -157,7 +157,10 @@ vec3<double> disk_light_specular_reference(const vec3<double>& n, const vec3<dou
     const vec3<double> s = detail::cap_integral(glm::normalize(vec3<double>(light.direction)), std::acos(1.0 - c), nodes,
                                                 [&](const vec3<double>& l) {
                                                     const light_cosines<double> lc = make_light_cosines(n, v, l);
-                                                    return specular_brdf_direct(n_dot_v, lc, f0, f90, roughness) * lc.n_dot_l;
+                                                    const double alpha = clamp_alpha(alpha_from_roughness(saturate(roughness)));
+                                                    return fresnel_schlick(lc.v_dot_h, f0, f90) *
+                                                           (ndf_ggx(lc.n_dot_h, alpha) *
+                                                            v_smith_ggx_correlated(n_dot_v, lc.n_dot_l, alpha) * lc.n_dot_l);
                                                 });
     return vec3<double>(light.radiance) * s;
 }
