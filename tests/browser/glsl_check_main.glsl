@@ -5,6 +5,8 @@
 uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
 uniform sampler2D u_lut;
+uniform sampler2D u_taps_a, u_taps_b;
+uniform int u_taps;
 uniform vec3 u_sh[9];
 uniform vec3 u_n, u_v, u_l;
 uniform float u_r;
@@ -35,5 +37,18 @@ void main() {
     vec3 dk = ibl_shade_disk(u_n, u_v, sun, m) + ibl_disk_light_irradiance(u_n, sun) +
               ibl_disk_light_specular(u_n, u_v, sun, m.f0, m.f90, u_r) + ibl_disk_light_normal_irradiance(sun);
     float cap = ibl_cap_irradiance(dot(u_n, u_l), ibl_cap_sin2(0.5)) + ibl_cap_one_minus_cos(0.5) + ibl_atan_minus_identity(u_r);
-    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap, 1.0);
+    float rt = ibl_dominant_lerp_frostbite(u_r) + ibl_horizon_fade(u_n, u_v) + ibl_specular_occlusion_lagarde(0.5, 0.75, u_r);
+    ibl_frame fr = ibl_make_frame(u_n);
+    vec3 vl = ibl_frame_to_local(fr, u_v);
+    vec3 h = ibl_sample_ggx_vndf(vl, ibl_fis_tap_point(3u, 8u), u_r * u_r);
+    rt += ibl_ggx_vndf_reflected_pdf(vl, h, u_r) + ibl_ggx_g1_over_n_dot_v(vl.z, u_r) + ibl_ndf_ggx_local(h, u_r) +
+          ibl_g2_over_g1_height_correlated(0.5, 0.25, u_r) + ibl_fis_footprint_roughness(0.5) + ibl_radical_inverse(5u) +
+          float(ibl_reverse_bits(7u) >> 28u) + ibl_normalize_scaled(u_l).x;
+    ibl_runtime_tap tap = ibl_fis_tap(fr, vl, u_r, 1u, 4u, 1.0, m.f0, m.f90);
+    vec3 fis = ibl_specular_fis(u_chain, tb, u_taps, 1.0, true, u_n, u_v, u_r, m.f0, m.f90, abk.xy) +
+               ibl_fis_combine(tap.weight, tap.weight, 4, false, m.f0, ld) + ibl_frame_to_world(fr, tap.dir) * tap.roughness;
+    vec3 it = ibl_incidence_tangent(u_n, u_l);
+    vec3 lt = ibl_specular_lobe_taps2(u_chain, sd, u_taps_a, u_taps_b, lay, u_n, u_v, u_r, m.f0, m.f90) +
+              ibl_lobe_tap_direction(u_n, it, 0.5);
+    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt, 1.0);
 }

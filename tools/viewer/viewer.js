@@ -155,7 +155,7 @@ async function fetchText(url) {
 
 async function libraryGlsl() {
     const parts = [];
-    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl']) parts.push(await fetchText(glslBase + f));
+    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl', 'ibl_runtime.glsl']) parts.push(await fetchText(glslBase + f));
     return parts.join('\n');
 }
 

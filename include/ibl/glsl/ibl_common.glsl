@@ -3,7 +3,8 @@
 // and GLSL 4.50; no #version line: the including shader writes it (and, in ES, the precision
 // statements: `precision highp float; precision highp int; precision highp samplerCube;`).
 // Concatenate in this order (GLSL has no #include): ibl_common.glsl, then any of
-// ibl_lookup.glsl, ibl_sh.glsl, ibl_shade.glsl (each guards itself against a second inclusion).
+// ibl_lookup.glsl, ibl_sh.glsl, ibl_shade.glsl, ibl_runtime.glsl (each guards itself against a
+// second inclusion; ibl_runtime.glsl needs ibl_lookup.glsl and ibl_shade.glsl).
 // docs/shaders.md has the API, a usage example and what the browser test measures.
 //
 // ---- Conventions (the library's, stated once) ---------------------------------------------------
@@ -36,6 +37,13 @@
 //           roughness), R = A, G = B, B = s (the lerp factor of the lookup direction
 //           normalize(lerp(n, R, s))), A = r_eff (the chain roughness to read there); specular =
 //           LD(d, r_eff) (F0 A + F90 B). Clamp to edge, bilinear (RGBA32F: lobe_lut.hpp's floats).
+// Taps LUT  the two-tap fitted model of ibl/runtime.hpp (specular_lobe_taps; lobe_fit.hpp's
+//           make_lobe_taps_lut with taps = 2): its eight channels per texel, in the DFG table's
+//           layout and orientation, as two RGBA textures of the same size: taps_a = channels
+//           0..3 (R = A, G = B, B = angle0 / (pi/2), A = roughness0), taps_b = channels 4..7
+//           (R = weight0, G = angle1 / (pi/2), B = roughness1, A = weight1); tap k reads the
+//           chain at cos(angle_k) n + sin(angle_k) t (t: the tangent of n towards R) and roughness_k.
+//           Clamp to edge, bilinear (RGBA32F: the table's floats).
 // SH        nine shader constants c_k (sh.json "irradiance_over_pi_shader") with
 //           E(n)/pi = sum c_k p_k(n), p = (1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2).
 // Radiance  linear, the units of the source; E/pi is the cosine-weighted mean radiance (a
