@@ -3,11 +3,16 @@
 // run_browser_test.py --mode numeric. Each row names the function and its bound: relative `rel`
 // plus absolute `abs` (docs/shaders.md derives them).
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <vector>
 
+#include <ibl/env/cube_geometry.hpp>
+#include <ibl/env/cubemap.hpp>
 #include <ibl/lookup.hpp>
 #include <ibl/runtime.hpp>
 #include <ibl/shade.hpp>
@@ -29,6 +34,390 @@ v3 dir_of(int i) {
 }
 
 ibl::specular_lookup_desc desc_default() { return {}; }
+
+// ---- the runtime rows' fixtures (tools/viewer/numeric.frag.glsl: u_chain, u_taps_a, u_taps_b) ----
+
+using v3d = vec3<double>;
+
+/// The chain of the runtime rows: 8^2 faces, 4 levels; level l holds the smooth field
+/// (1.5 + d.x + 0.5 d.y - 0.25 d.z, 1.25 - 0.5 d.x + 0.75 d.z, 1 + 0.25 d.y) (1 - l/8) at the texel
+/// centres d (so every texel difference is small: see fis_bound).
+const ibl::cubemap<float>& fixture_chain() {
+    static const ibl::cubemap<float> chain = [] {
+        ibl::cubemap<float> c(8, 4);
+        for (int l = 0; l < 4; ++l) {
+            const int n = c.size(l);
+            const double s = 1.0 - double(l) / 8.0;
+            c.fill(l, [&](int f, int x, int y) {
+                const v3d d = ibl::cube_texel_direction<double>(f, x, y, n);
+                return v3(float(s * (1.5 + d.x + 0.5 * d.y - 0.25 * d.z)), float(s * (1.25 - 0.5 * d.x + 0.75 * d.z)),
+                          float(s * (1.0 + 0.25 * d.y)));
+            });
+        }
+        c.update_borders();
+        return c;
+    }();
+    return chain;
+}
+
+/// The two-tap table (lobe_taps_lut's members): 4^2 texels of 8 channels (A, B, angle0 / (pi/2),
+/// r0, w0, angle1 / (pi/2), r1, w1), smooth in (i, j), both weights 0 at texels (0, 0) and (1, 0)
+/// (the fallback), weight 0 of tap 1 on row 0.
+struct taps_table {
+    std::uint32_t size = 4, channels = 8;
+    int taps = 2;
+    std::vector<float> data;
+};
+
+const taps_table& fixture_taps() {
+    static const taps_table t = [] {
+        taps_table lut;
+        lut.data.resize(4 * 4 * 8);
+        for (int j = 0; j < 4; ++j)
+            for (int i = 0; i < 4; ++i) {
+                float* p = &lut.data[std::size_t(j * 4 + i) * 8];
+                const float fi = float(i), fj = float(j);
+                p[0] = 0.25f + 0.125f * fi - 0.0625f * fj;
+                p[1] = 0.5f - 0.0625f * fi - 0.03125f * fj;
+                p[2] = 0.125f + 0.125f * fi + 0.0625f * fj;
+                p[3] = 0.125f + 0.25f * fj;
+                p[4] = j == 0 && i < 2 ? 0.0f : 0.25f + 0.0625f * fi + 0.125f * fj;
+                p[5] = 0.375f + 0.0625f * fi + 0.125f * fj;
+                p[6] = 0.25f + 0.1875f * fj + 0.03125f * fi;
+                p[7] = j == 0 ? 0.0f : 0.125f * fj + 0.0625f * fi;
+            }
+        return lut;
+    }();
+    return t;
+}
+
+ibl::specular_lookup_desc chain_lookup(bool textbook) {
+    return textbook ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc{};
+}
+
+/// The runtime rows' view and normal: n = dir_of(i), v = dir_of((7 i + 3) mod 64).
+v3 fis_n(int i) { return dir_of(i); }
+v3 fis_v(int i) { return dir_of((7 * i + 3) % 64); }
+
+/// specular_fis's tangent-space view: to_local, z clamped to >= 0, normalised.
+v3 fis_view_local(const ibl::frame<float>& fr, const v3& v) {
+    v3 vl = fr.to_local(v);
+    vl.z = vl.z > 0.0f ? vl.z : 0.0f;
+    const float len2 = glm::dot(vl, vl);
+    return len2 > 0.0f ? vl / std::sqrt(len2) : v3(0.0f, 0.0f, 1.0f);
+}
+
+/// The VNDF row's inputs: a tangent-space view with z >= 1/16, u = fis_tap_point(i mod 16, 16),
+/// roughness 0.25 (1 + i / 16).
+v3 vndf_v(int i) {
+    return glm::normalize(v3(float(i % 8) * 0.25f - 0.875f, float(i % 3) * 0.25f - 0.25f, float(i / 8) * 0.125f + 0.0625f));
+}
+ibl::vec2<float> vndf_u(int i) { return ibl::fis_tap_point<float>(std::uint32_t(i % 16), 16u); }
+float vndf_alpha(int i) {
+    const float r = 0.25f * float(1 + i / 16);
+    return r * r;
+}
+
+/// Absolute error of GLSL sin / cos: GLSL ES 3.00 specifies none; Vulkan (SwiftShader's, under
+/// ANGLE) requires 2^-11 on [-pi, pi], where every argument of the runtime rows lies (the "sin / cos"
+/// row checks it at those arguments; SwiftShader measured 1.6e-4).
+constexpr double trig_eps = 1.0 / 2048.0; // 2^-11
+
+/// A bound on the GPU's error in sample_ggx_vndf's h (each component), recomputing the sampler's
+/// intermediates in double: sin enters h_s . e1 as 2 sin_c s_half^2 (error <= 4 sin_c |s_half| eps)
+/// and h_s . e2 as -sin_c sin(psi) (<= sin_c eps); with the float rounding of h_s (1e-5 |h_s|, the
+/// rows' arithmetic term) that is dp, and unstretching p = (a h_s.x, a h_s.y, h_s.z) then
+/// normalising moves h by <= dp / |p|, plus the final normalisation's rounding (1e-5).
+double vndf_dh(const v3& v, const ibl::vec2<float>& u, float alpha) {
+    const double a = ibl::clamp_alpha(double(alpha));
+    v3d vs(a * v.x, a * v.y, std::fmin(std::fmax(double(v.z), 0.0), 1.0));
+    vs /= std::sqrt(glm::dot(vs, vs));
+    const double rho2 = vs.x * vs.x + vs.y * vs.y, rho = std::sqrt(rho2);
+    const double opz = 1.0 + vs.z, omz = rho2 / opz, w = 1.0 - double(u.y);
+    const double sin_c = std::sqrt(std::fmax(double(u.y) * opz * (omz + w * opz), 0.0));
+    const double q = vs.z < 0.5 ? w - vs.z * (1.0 + double(u.y)) : omz - double(u.y) * opz;
+    const double rms = rho + sin_c > 0.0 ? opz * w * q / (rho + sin_c) : 0.0;
+    const double psi = 2.0 * ibl::pi_v<double> * (double(u.x) - 0.5), sh = std::sin(0.5 * psi);
+    const double x1 = rms + 2.0 * sin_c * sh * sh, x2 = -sin_c * std::sin(psi), z = w * opz;
+    const double hs_len = std::sqrt(x1 * x1 + x2 * x2 + z * z);
+    const double p_len = std::sqrt(a * a * (x1 * x1 + x2 * x2) + z * z);
+    const double dp = trig_eps * (4.0 * sin_c * std::fabs(sh) + sin_c) + 1e-5 * hs_len;
+    return dp / p_len + 1e-5;
+}
+
+/// fis_tap's body from a given half vector h (double): what fis_tap makes of h, so that the
+/// effect of an error in h on the tap is measurable. The reference checks it reproduces fis_tap.
+template <class T> ibl::runtime_tap<T> tap_from_h(const ibl::frame<T>& fr, const vec3<T>& vl, T roughness, const vec3<T>& h,
+                                                  std::uint32_t count, T c, const vec3<T>& f0, const vec3<T>& f90) {
+    ibl::runtime_tap<T> t;
+    const T alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(roughness));
+    const T v_dot_h = glm::dot(vl, h);
+    const vec3<T> l = T(2) * v_dot_h * h - vl;
+    t.dir = fr.to_world(l);
+    if (!(l.z > T(0)) || !(v_dot_h > T(0))) return t;
+    const T pdf = ibl::ggx_vndf_reflected_pdf(vl, h, alpha);
+    t.roughness = pdf > T(0) ? ibl::fis_footprint_roughness(c / (T(count) * pdf)) : T(1);
+    t.weight = ibl::fresnel_schlick(ibl::saturate(v_dot_h), f0, f90) * ibl::g2_over_g1_height_correlated(vl.z, l.z, alpha);
+    return t;
+}
+
+template <class T> vec3<T> to_d(const vec3<float>& a) { return vec3<T>(T(a.x), T(a.y), T(a.z)); }
+
+/// The spread of f(h') over h' = normalize(h +- dh e_k) (k = x, y, z): per output value, the root
+/// sum of squares of the larger change along each axis (a first-order bound of |grad f| dh that
+/// also catches a discontinuity, e.g. the horizon clip, within dh).
+template <class F> v4 spread(const v3d& h, double dh, F&& f) {
+    const ibl::vec4<double> f0 = f(h);
+    ibl::vec4<double> acc(0.0);
+    for (int k = 0; k < 3; ++k) {
+        ibl::vec4<double> m(0.0);
+        for (double sg : {-1.0, 1.0}) {
+            v3d e(0.0);
+            e[k] = sg * dh;
+            const ibl::vec4<double> d = glm::abs(f(glm::normalize(h + e)) - f0);
+            m = glm::max(m, d);
+        }
+        acc += m * m;
+    }
+    return v4(glm::sqrt(acc));
+}
+
+/// The VNDF row's per-value bound: the spread of (h, pdf) over the error of h.
+v4 vndf_bound(int i) {
+    const v3 v = vndf_v(i);
+    const auto u = vndf_u(i);
+    const float alpha = vndf_alpha(i);
+    const v3 h = ibl::sample_ggx_vndf(v, u, alpha);
+    const double dh = vndf_dh(v, u, alpha);
+    return spread(to_d<double>(h), dh, [&](const v3d& hh) {
+        return ibl::vec4<double>(hh, ibl::ggx_vndf_reflected_pdf(to_d<double>(v), hh, double(alpha)));
+    });
+}
+
+/// The tap rows' taps: k = i mod 8 of 8, roughness 0.125 (1 + i / 8), c = 1, F0 (0.04, 0.5, 1), F90 1.
+struct tap_case {
+    ibl::frame<float> fr;
+    v3 vl, f0, f90;
+    float r;
+    std::uint32_t k, count;
+};
+tap_case tap_case_of(int i) {
+    tap_case c;
+    c.fr = ibl::make_frame(fis_n(i));
+    c.vl = fis_view_local(c.fr, fis_v(i));
+    c.r = 0.125f * float(1 + i / 8);
+    c.k = std::uint32_t(i % 8);
+    c.count = 8;
+    c.f0 = v3(0.04f, 0.5f, 1.0f);
+    c.f90 = v3(1.0f);
+    return c;
+}
+
+/// A tap's bound: the spread of (dir, roughness) and of weight over the error of its h.
+void tap_bounds(const ibl::frame<float>& fr, const v3& vl, float r, std::uint32_t k, std::uint32_t count, float c,
+                const v3& f0, const v3& f90, v4& b_dir, v4& b_w) {
+    const float alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(r));
+    const auto u = ibl::fis_tap_point<float>(k, count);
+    const v3 h = ibl::sample_ggx_vndf(vl, u, alpha);
+    const double dh = vndf_dh(vl, u, alpha);
+    const ibl::frame<double> frd{to_d<double>(fr.t), to_d<double>(fr.b), to_d<double>(fr.n)};
+    auto tap = [&](const v3d& hh) {
+        return tap_from_h<double>(frd, to_d<double>(vl), double(r), hh, count, double(c), to_d<double>(f0), to_d<double>(f90));
+    };
+    b_dir = spread(to_d<double>(h), dh, [&](const v3d& hh) {
+        const auto t = tap(hh);
+        return ibl::vec4<double>(t.dir, t.roughness);
+    });
+    b_w = spread(to_d<double>(h), dh, [&](const v3d& hh) { return ibl::vec4<double>(tap(hh).weight, 0.0); });
+}
+
+/// |change| of the chain lookup over a direction error dd (+- along each axis, renormalised) and a
+/// roughness error dr (root sum of squares of the larger change per axis, per channel).
+v3 lookup_spread(const v3& dir, float r, double dd, double dr, const ibl::specular_lookup_desc& sd) {
+    const auto& chain = fixture_chain();
+    const v3 l0 = ibl::specular_lookup(chain, dir, r, sd);
+    v3d acc(0.0);
+    for (int k = 0; k < 4; ++k) {
+        v3d m(0.0);
+        for (float sg : {-1.0f, 1.0f}) {
+            v3 d = dir;
+            float rr = r;
+            if (k < 3) d[k] += sg * float(dd);
+            else rr = ibl::saturate(r + sg * float(dr));
+            const v3 l1 = ibl::specular_lookup(chain, glm::normalize(d), rr, sd);
+            m = glm::max(m, glm::abs(to_d<double>(l1) - to_d<double>(l0)));
+        }
+        acc += m * m;
+    }
+    return v3(glm::sqrt(acc));
+}
+
+/// Floor of a lookup direction's error: the cube coordinates (sc / |ma|, then s N - 1/2) are
+/// formed in float on both sides, a few ulp of each: 2^-20 covers them.
+constexpr double dir_floor = 1.0 / 1048576.0;
+
+/// The full-FIS rows' per-value bound: for each tap, its direction / roughness / weight errors
+/// (tap_bounds) move its lookup by lookup_spread, and the combination turns them into
+///   normalised: albedo (sum w dLD + sum dw |LD - Q|) / (sum w - sum dw),  Q = sum w LD / sum w
+///   plain:      (sum w dLD + sum dw LD) / K
+/// per channel (first order); a channel without weight uses the fallback lookup at R and r.
+v4 fis_bound(int i, std::uint32_t taps, float c, bool normalise, bool textbook, float r, const v3& f0, const v3& f90,
+             const ibl::vec2<float>& dfg) {
+    const auto& chain = fixture_chain();
+    const auto sd = chain_lookup(textbook);
+    const ibl::frame<float> fr = ibl::make_frame(fis_n(i));
+    const v3 vl = fis_view_local(fr, fis_v(i));
+    v3d sum(0.0), wsum(0.0), dsum(0.0), dwsum(0.0);
+    struct tap_rec {
+        v3d ld, w, dw;
+    };
+    std::vector<tap_rec> rec;
+    for (std::uint32_t k = 0; k < taps; ++k) {
+        const auto t = ibl::fis_tap(fr, vl, r, k, taps, c, f0, f90);
+        v4 bd, bw;
+        tap_bounds(fr, vl, r, k, taps, c, f0, f90, bd, bw);
+        const double dd = std::sqrt(double(bd.x) * bd.x + double(bd.y) * bd.y + double(bd.z) * bd.z) + dir_floor;
+        const v3d dw = to_d<double>(v3(bw.x, bw.y, bw.z)) + 1e-5 * glm::abs(to_d<double>(t.weight));
+        const v3d ld = to_d<double>(ibl::specular_lookup(chain, t.dir, t.roughness, sd));
+        const v3d dld = to_d<double>(lookup_spread(t.dir, t.roughness, dd, double(bd.w) + 1e-5, sd)) + 1e-5 * ld;
+        const v3d w = to_d<double>(t.weight);
+        sum += w * ld;
+        wsum += w;
+        dsum += w * dld;
+        dwsum += dw;
+        rec.push_back({ld, w, dw});
+    }
+    const v3d albedo = to_d<double>(ibl::split_sum_albedo(f0, f90, dfg));
+    v3d out(0.0);
+    for (int ch = 0; ch < 3; ++ch) {
+        if (!normalise) {
+            double e = dsum[ch];
+            for (const auto& t : rec) e += t.dw[ch] * t.ld[ch];
+            out[ch] = e / double(taps);
+        } else if (wsum[ch] > 0.0 && wsum[ch] > dwsum[ch]) {
+            const double q = sum[ch] / wsum[ch];
+            double e = dsum[ch];
+            for (const auto& t : rec) e += t.dw[ch] * std::fabs(t.ld[ch] - q);
+            out[ch] = albedo[ch] * e / (wsum[ch] - dwsum[ch]);
+        } else if (wsum[ch] > 0.0) {
+            out[ch] = 1e30; // the weights' errors swamp them: no bound (the row avoids this)
+        } else {
+            const v3 rd = fr.to_world(v3(-vl.x, -vl.y, vl.z));
+            out[ch] = albedo[ch] * (double(lookup_spread(rd, r, dir_floor, 1e-5, sd)[ch]) +
+                                    1e-5 * double(ibl::specular_lookup(chain, rd, r, sd)[ch]));
+            out[ch] += dwsum[ch] > 0.0 ? 1e30 : 0.0; // a weight could be > 0 on the GPU
+        }
+    }
+    return {v3(out), 0.0f};
+}
+
+/// The taps row's per-value bound: each table channel read within 1e-5 (the sampler coordinate,
+/// formed with pow and a division, within a few ulp, times N = 4 texels, times neighbouring
+/// channel differences < 1), each tap direction within 2 trig_eps + 1e-5 (cos, sin of float angles;
+/// normalize) plus the angle's error pi/2 1e-5, the roughness within 1e-5, and the combination as
+/// in fis_bound (normalised); A, B within 1e-5 enter the albedo.
+v4 taps_bound(int i, float r, const v3& f0, const v3& f90, bool textbook) {
+    const auto& chain = fixture_chain();
+    const auto& lut = fixture_taps();
+    const auto sd = chain_lookup(textbook);
+    const v3 n = fis_n(i), v = fis_v(i);
+    const float n_dot_v = ibl::saturate(glm::dot(n, v));
+    const v3 r_dir = 2.0f * glm::dot(n, v) * n - v;
+    const auto st = ibl::dfg_lut_coord(n_dot_v, r, lut.size, ibl::dfg_lut_layout{});
+    float p[8] = {};
+    ibl::detail::table_bilinear(lut, st.x, st.y, p, 8);
+    const v3 t = ibl::incidence_tangent(n, r_dir);
+    constexpr double dp = 1e-5;
+    const double dd = 2.0 * trig_eps + 1e-5 + ibl::half_pi_v<double> * dp + dir_floor;
+    v3d sum(0.0), dsum(0.0);
+    double wsum = 0.0, dwsum = 0.0;
+    std::vector<v3d> lds;
+    std::vector<double> ws;
+    for (int k = 0; k < 2; ++k) {
+        const float a = p[2 + 3 * k] * ibl::half_pi_v<float>, w = p[4 + 3 * k];
+        if (!(w > 0.0f)) {
+            // a weight of 0 interpolated from non-zero texels (bilinear weight 0) may be read as
+            // up to dp, with a lookup below 3.5 (the chain's largest channel)
+            dwsum += dp;
+            dsum += v3d(3.5 * dp);
+            continue;
+        }
+        const v3 d = glm::normalize(std::cos(a) * n + std::sin(a) * t);
+        const v3d ld = to_d<double>(ibl::specular_lookup(chain, d, p[3 + 3 * k], sd));
+        sum += double(w) * ld;
+        dsum += double(w) * (to_d<double>(lookup_spread(d, p[3 + 3 * k], dd, dp, sd)) + 1e-5 * ld);
+        wsum += w;
+        dwsum += dp;
+        lds.push_back(ld);
+        ws.push_back(w);
+    }
+    const v3d albedo = to_d<double>(ibl::split_sum_albedo(f0, f90, ibl::vec2<float>(p[0], p[1])));
+    const v3d dalbedo = dp * (glm::abs(to_d<double>(f0)) + glm::abs(to_d<double>(f90)));
+    if (!(wsum > 0.0)) {
+        // the fallback: both weights read exactly 0 (texels whose weights are 0 on both sides)
+        const v3d ld = to_d<double>(ibl::specular_lookup(chain, r_dir, r, sd));
+        return {v3(albedo * (to_d<double>(lookup_spread(r_dir, r, dir_floor, 1e-5, sd)) + 1e-5 * ld) + dalbedo * ld), 0.0f};
+    }
+    const v3d q = sum / wsum;
+    v3d e = dsum;
+    for (std::size_t k = 0; k < lds.size(); ++k) e += dp * glm::abs(lds[k] - q);
+    return {v3(albedo * e / (wsum - dwsum) + dalbedo * q), 0.0f};
+}
+
+
+/// The taps row's roughness: 0 at every fourth case (the mirror row of the table, where the
+/// fallback is read at grazing views), else i / 64.
+float taps_r(int i) { return i % 4 == 0 ? 0.0f : u64(i); }
+ibl::vec2<float> fis_dfg(int i) { return {0.125f + float(i % 8) * 0.0625f, float(i / 8) * 0.03125f}; }
+v3 fis_f0(int i) { return v3(0.04f + 0.0625f * float(i % 8), 0.5f, 1.0f); }
+
+v4 runtime_row(int j, int i) {
+    const float x = u64(i);
+    if (j == 18) {
+        const v3 g = dir_of(63 - i) * v3(1.0f, -1.0f, 1.0f);
+        return {ibl::dominant_lerp_frostbite(x), ibl::horizon_fade(dir_of(i), g),
+                ibl::specular_occlusion_lagarde(1.0f - x, float(i % 8) * 0.125f, x),
+                ibl::specular_occlusion_lagarde(x, float(i / 8) * 0.125f + 0.0625f, 1.0f - x)};
+    }
+    if (j == 19) {
+        const auto tp = ibl::fis_tap_point<float>(std::uint32_t(i), std::uint32_t(8 + i % 24));
+        return {ibl::g2_over_g1_height_correlated(1.0f - x, float(i % 8) * 0.125f, x), ibl::fis_footprint_roughness(4.0f * x),
+                tp.x, tp.y};
+    }
+    if (j == 20) { // sin / cos at the VNDF row's azimuths and at angles x pi/2 (double reference)
+        const auto u = vndf_u(i);
+        const float psi = ibl::two_pi_v<float> * (u.x - 0.5f), a = x * ibl::half_pi_v<float>;
+        return v4(ibl::vec4<double>(std::sin(double(0.5f * psi)), std::sin(double(psi)), std::cos(double(a)),
+                                    std::sin(double(a))));
+    }
+    if (j == 21) {
+        const v3 v = vndf_v(i);
+        const v3 h = ibl::sample_ggx_vndf(v, vndf_u(i), vndf_alpha(i));
+        return {h, ibl::ggx_vndf_reflected_pdf(v, h, vndf_alpha(i))};
+    }
+    if (j == 22 || j == 23) {
+        const tap_case c = tap_case_of(i);
+        const auto t = ibl::fis_tap(c.fr, c.vl, c.r, c.k, c.count, 1.0f, c.f0, c.f90);
+        return j == 22 ? v4(t.dir, t.roughness) : v4(t.weight, 0.0f);
+    }
+    if (j == 24 || j == 25) { // specular_fis on the fixture chain: normalised 8 taps textbook / plain 16 taps default, c = 2
+        ibl::runtime_fis_desc d;
+        d.taps = j == 24 ? 8u : 16u;
+        d.footprint_scale = j == 24 ? 1.0f : 2.0f;
+        d.normalise = j == 24;
+        d.lookup = chain_lookup(j == 24);
+        return {ibl::specular_fis(fixture_chain(), d, fis_n(i), fis_v(i), x, fis_f0(i), v3(1.0f), fis_dfg(i)), 0.0f};
+    }
+    if (j == 26)
+        return {ibl::specular_lobe_taps(fixture_chain(), chain_lookup(false), fixture_taps(), ibl::dfg_lut_layout{}, fis_n(i),
+                                        fis_v(i), taps_r(i), fis_f0(i), v3(1.0f)),
+                0.0f};
+    if (j == 27) { // incidence tangent; every fourth case R = n (the frame's tangent)
+        const v3 n = dir_of(i), r = i % 4 == 0 ? n : dir_of(63 - i);
+        return {ibl::incidence_tangent(n, r), 0.0f};
+    }
+    return v4(0.0f);
+}
 
 v4 row_value(int j, int i) {
     const float x = u64(i);
@@ -121,6 +510,7 @@ v4 row_value(int j, int i) {
         const v3 d = ibl::lerp_direction(a, 2.0f * glm::dot(a, b) * a - b, x);
         return {d, glm::dot(d, a)};
     }
+    if (j >= 18) return runtime_row(j, i);
     if (j == 12)
         return {ibl::roughness_from_lod(ibl::roughness_mapping::filament, x * 4.0f, 4.0f),
                 ibl::lod_from_roughness(ibl::roughness_mapping::filament, x, 4.0f),
@@ -167,7 +557,88 @@ struct row_info {
 
 } // namespace
 
-int main() {
+
+/// The runtime rows' per-value absolute bounds (replacing the row's abs; the 1e-5 relative term
+/// stays): the arithmetic's 1e-6 plus what the errors of sin and of the inputs become (above).
+bool runtime_abs_bound(int j, int i, v4& out) {
+    const v4 base(1e-6f);
+    if (j == 21) {
+        out = base + vndf_bound(i);
+        return true;
+    }
+    if (j == 22 || j == 23) {
+        const tap_case c = tap_case_of(i);
+        v4 bd, bw;
+        tap_bounds(c.fr, c.vl, c.r, c.k, c.count, 1.0f, c.f0, c.f90, bd, bw);
+        out = base + (j == 22 ? bd : bw);
+        return true;
+    }
+    if (j == 24 || j == 25) {
+        out = base + fis_bound(i, j == 24 ? 8u : 16u, j == 24 ? 1.0f : 2.0f, j == 24, j == 24, u64(i), fis_f0(i), v3(1.0f),
+                               fis_dfg(i));
+        return true;
+    }
+    if (j == 26) {
+        out = base + taps_bound(i, taps_r(i), fis_f0(i), v3(1.0f), false);
+        return true;
+    }
+    if (j == 27) { // t = normalize(R - (n.R) n): an error 2^-21 of the unit inputs over |R - (n.R) n|
+        const v3 n = dir_of(i), r = i % 4 == 0 ? n : dir_of(63 - i);
+        const v3 t = r - glm::dot(n, r) * n;
+        const float len = std::sqrt(glm::dot(t, t));
+        out = base + v4(len > 1e-6f ? float(std::ldexp(1.0, -21)) / len : 0.0f);
+        return true;
+    }
+    return false;
+}
+
+/// The fixtures as JSON for the page (run_browser_test.py serves them): the chain's levels (faces
+/// +X..-Z, rows from t = 0, RGB) and the two RGBA halves of the taps table.
+void print_fixtures() {
+    const auto& chain = fixture_chain();
+    std::printf("{\"chain\": [");
+    for (int l = 0; l < chain.levels(); ++l) {
+        const int n = chain.size(l);
+        std::printf("%s{\"size\": %d, \"faces\": [", l ? ", " : "", n);
+        for (int f = 0; f < 6; ++f) {
+            std::printf("%s[", f ? ", " : "");
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const v3 t = chain.texel(f, x, y, l);
+                    std::printf("%s%.9g, %.9g, %.9g", x || y ? ", " : "", double(t.x), double(t.y), double(t.z));
+                }
+            std::printf("]");
+        }
+        std::printf("]}");
+    }
+    const auto& lut = fixture_taps();
+    std::printf("], \"taps\": {\"size\": %u, \"a\": [", lut.size);
+    for (int half = 0; half < 2; ++half) {
+        if (half) std::printf("], \"b\": [");
+        for (std::uint32_t k = 0; k < lut.size * lut.size; ++k)
+            for (int c = 0; c < 4; ++c)
+                std::printf("%s%.9g", k || c ? ", " : "", double(lut.data[k * 8 + std::size_t(4 * half + c)]));
+    }
+    std::printf("]}}\n");
+}
+
+int main(int argc, char** argv) {
+    if (argc > 1 && std::strcmp(argv[1], "--fixtures") == 0) {
+        print_fixtures();
+        return 0;
+    }
+    // tap_from_h (the tap rows' bounds perturb its h) must be fis_tap's body: same taps, bit for bit.
+    for (int i = 0; i < width; ++i) {
+        const tap_case c = tap_case_of(i);
+        const float alpha = ibl::clamp_alpha(ibl::alpha_from_roughness(c.r));
+        const v3 h = ibl::sample_ggx_vndf(c.vl, ibl::fis_tap_point<float>(c.k, c.count), alpha);
+        const auto a = ibl::fis_tap(c.fr, c.vl, c.r, c.k, c.count, 1.0f, c.f0, c.f90);
+        const auto b = tap_from_h<float>(c.fr, c.vl, c.r, h, c.count, 1.0f, c.f0, c.f90);
+        if (!(a.dir == b.dir && a.weight == b.weight && a.roughness == b.roughness)) {
+            std::fprintf(stderr, "glsl_reference: tap_from_h differs from ibl::fis_tap at case %d\n", i);
+            return 1;
+        }
+    }
     // Bounds: GLSL ES 3.00 highp (IEEE single storage): +, -, * correctly rounded, / and
     // inversesqrt 2.5 / 2 ulp, exp2 / log2 (3 + 2|x|) ulp, pow inherited from exp2(y log2 x).
     // A row's value passes through <= ~30 such operations: 1e-5 relative (~80 ulp) covers it; the
@@ -186,9 +657,19 @@ int main() {
         {"shade_disk (sun, r >= 0.25)", 1e-5 + disk_rel(6.8e-5, 0.25), 1e-6},
         {"lerp_direction", 1e-5, 1e-6},
         {"lobe direction (+ its n.d)", 1e-5, 1e-6},
+        {"frostbite, horizon, occlusion", 1e-5, 1e-6},
+        {"g2/g1, footprint r, tap point", 1e-5, 1e-6},
+        {"sin / cos (trig_eps)", 0.0, trig_eps},
+        {"VNDF h + reflected pdf", 1e-5, 0.0},
+        {"fis_tap dir + roughness", 1e-5, 0.0},
+        {"fis_tap weight", 1e-5, 0.0},
+        {"specular_fis (8, normalised)", 1e-5, 0.0},
+        {"specular_fis (16, plain, c=2)", 1e-5, 0.0},
+        {"specular_lobe_taps2", 1e-5, 0.0},
+        {"incidence_tangent", 1e-5, 0.0},
     };
-    std::printf("{\"width\": %d, \"height\": 18, \"rows\": [", width);
     const int n_rows = int(sizeof(rows) / sizeof(rows[0]));
+    std::printf("{\"width\": %d, \"height\": %d, \"rows\": [", width, n_rows);
     for (int j = 0; j < n_rows; ++j) {
         std::printf("%s\n{\"row\": %d, \"name\": \"%s\", \"rel\": %g, \"abs\": %g, \"values\": [", j ? "," : "", j, rows[j].name,
                     rows[j].rel, rows[j].abs);
@@ -202,6 +683,15 @@ int main() {
             for (int i = 0; i < width; ++i)
                 std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", cap_abs_bound(i, 0), cap_abs_bound(i, 1),
                             cap_abs_bound(i, 2), cap_abs_bound(i, 3));
+            std::printf("]");
+        }
+        v4 b;
+        if (runtime_abs_bound(j, 0, b)) {
+            std::printf(", \"abs_values\": [");
+            for (int i = 0; i < width; ++i) {
+                runtime_abs_bound(j, i, b);
+                std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", double(b.x), double(b.y), double(b.z), double(b.w));
+            }
             std::printf("]");
         }
         std::printf("}");

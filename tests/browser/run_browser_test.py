@@ -12,7 +12,8 @@ SwiftShader's WebGL2), compared with the C++.
            interactive viewer to --out (docs/shaders-viewer.png).
   numeric  lets tools/viewer/numeric.frag.glsl evaluate the GLSL functions on a fixed grid of
            inputs and compares them with the same grid evaluated by the library in C++
-           (glsl_reference, tests/browser/glsl_reference.cpp).
+           (glsl_reference, tests/browser/glsl_reference.cpp); the page uploads the fixtures
+           `glsl_reference --fixtures` prints (served as /bake/numeric_fixtures.json).
 
 Everything this script starts (the bake, Chromium, the HTTP server thread) ends before it returns.
 Exit status 0 = pass. docs/shaders.md explains the bounds.
@@ -414,6 +415,9 @@ def main():
             subprocess.run([a.tool, "--size", a.size, "--quality", a.quality, "--out", bake_dir, "--quiet"] +
                            (["--input", a.input] if a.input else []) + a.bake_args.split(), check=True,
                            stdout=subprocess.DEVNULL)
+        if a.mode == "numeric":  # the runtime rows' fixtures (a chain and a table), served to the page
+            fixtures = subprocess.run([a.reference, "--fixtures"], check=True, capture_output=True, text=True).stdout
+            open(os.path.join(bake_dir, "numeric_fixtures.json"), "w").write(fixtures)
         server = Server(os.path.abspath(a.repo), bake_dir)
         if a.mode == "screenshot":
             try:

@@ -1,8 +1,12 @@
 // tools/viewer/numeric.frag.glsl — evaluates the library's GLSL functions on a fixed grid of
-// inputs: output pixel (i, j) of a 64 x 18 RGBA32F target holds case i of row j. The same grid
+// inputs: output pixel (i, j) of a 64 x 28 RGBA32F target holds case i of row j. The same grid
 // evaluated by the C++ library is tests/browser/glsl_reference.cpp; the two must agree (the
-// inputs are built only from exact operations: multiples of 1/64, small integers).
+// inputs are built only from exact operations: multiples of 1/64, small integers). The runtime
+// rows read the reference's fixtures (glsl_reference --fixtures, uploaded by the page): an 8^2
+// RGBA32F chain of 4 levels and the two RGBA32F halves of a 4^2 two-tap table.
 
+uniform samplerCube u_chain;
+uniform sampler2D u_taps_a, u_taps_b;
 out vec4 o_color;
 
 float u64(int i) { return i == 63 ? 1.0 : float(i) * 0.015625; } // i / 64, and 1 at the end
@@ -12,7 +16,75 @@ vec3 dir_of(int i) { // a deterministic unit vector per case (normalised in floa
     return normalize(vec3(a, 0.5 + 0.0625 * float(i % 5), b));
 }
 
+// ---- the runtime rows (glsl_reference.cpp: the same inputs) ----
+
+vec3 fis_n(int i) { return dir_of(i); }
+vec3 fis_v(int i) { return dir_of((7 * i + 3) % 64); }
+vec3 fis_view_local(ibl_frame fr, vec3 v) { // as ibl_specular_fis forms it
+    vec3 vl = ibl_frame_to_local(fr, v);
+    vl.z = vl.z > 0.0 ? vl.z : 0.0;
+    float len2 = dot(vl, vl);
+    return len2 > 0.0 ? vl / sqrt(len2) : vec3(0.0, 0.0, 1.0);
+}
+vec3 vndf_v(int i) {
+    return normalize(vec3(float(i % 8) * 0.25 - 0.875, float(i % 3) * 0.25 - 0.25, float(i / 8) * 0.125 + 0.0625));
+}
+vec2 vndf_u(int i) { return ibl_fis_tap_point(uint(i % 16), 16u); }
+float vndf_alpha(int i) {
+    float r = 0.25 * float(1 + i / 16);
+    return r * r;
+}
+float taps_r(int i) { return i % 4 == 0 ? 0.0 : u64(i); }
+vec2 fis_dfg(int i) { return vec2(0.125 + float(i % 8) * 0.0625, float(i / 8) * 0.03125); }
+vec3 fis_f0(int i) { return vec3(0.04 + 0.0625 * float(i % 8), 0.5, 1.0); }
+ibl_specular_desc chain_desc(bool textbook) {
+    if (textbook) return ibl_specular_textbook(4, 0, 4);
+    return ibl_specular_default(4, 0, 4);
+}
+
+vec4 runtime_row(int j, int i) {
+    float x = u64(i);
+    if (j == 18) {
+        vec3 g = dir_of(63 - i) * vec3(1.0, -1.0, 1.0);
+        return vec4(ibl_dominant_lerp_frostbite(x), ibl_horizon_fade(dir_of(i), g),
+                    ibl_specular_occlusion_lagarde(1.0 - x, float(i % 8) * 0.125, x),
+                    ibl_specular_occlusion_lagarde(x, float(i / 8) * 0.125 + 0.0625, 1.0 - x));
+    }
+    if (j == 19) {
+        vec2 tp = ibl_fis_tap_point(uint(i), uint(8 + i % 24));
+        return vec4(ibl_g2_over_g1_height_correlated(1.0 - x, float(i % 8) * 0.125, x), ibl_fis_footprint_roughness(4.0 * x),
+                    tp);
+    }
+    if (j == 20) { // sin / cos at the VNDF row's azimuths and at angles x pi/2
+        float psi = 2.0 * IBL_PI * (vndf_u(i).x - 0.5), a = x * (0.5 * IBL_PI);
+        return vec4(sin(0.5 * psi), sin(psi), cos(a), sin(a));
+    }
+    if (j == 21) {
+        vec3 v = vndf_v(i);
+        vec3 h = ibl_sample_ggx_vndf(v, vndf_u(i), vndf_alpha(i));
+        return vec4(h, ibl_ggx_vndf_reflected_pdf(v, h, vndf_alpha(i)));
+    }
+    if (j == 22 || j == 23) { // tap i mod 8 of 8, roughness 0.125 (1 + i / 8), c = 1
+        ibl_frame fr = ibl_make_frame(fis_n(i));
+        ibl_runtime_tap t = ibl_fis_tap(fr, fis_view_local(fr, fis_v(i)), 0.125 * float(1 + i / 8), uint(i % 8), 8u, 1.0,
+                                        vec3(0.04, 0.5, 1.0), vec3(1.0));
+        return j == 22 ? vec4(t.dir, t.roughness) : vec4(t.weight, 0.0);
+    }
+    if (j == 24) return vec4(ibl_specular_fis(u_chain, chain_desc(true), 8, 1.0, true, fis_n(i), fis_v(i), x, fis_f0(i),
+                                              vec3(1.0), fis_dfg(i)), 0.0);
+    if (j == 25) return vec4(ibl_specular_fis(u_chain, chain_desc(false), 16, 2.0, false, fis_n(i), fis_v(i), x, fis_f0(i),
+                                              vec3(1.0), fis_dfg(i)), 0.0);
+    if (j == 26) return vec4(ibl_specular_lobe_taps2(u_chain, chain_desc(false), u_taps_a, u_taps_b, ibl_dfg_layout_default(),
+                                                     fis_n(i), fis_v(i), taps_r(i), fis_f0(i), vec3(1.0)), 0.0);
+    if (j == 27) { // incidence tangent; every fourth case R = n (the frame's tangent)
+        vec3 n = dir_of(i), r = i % 4 == 0 ? n : dir_of(63 - i);
+        return vec4(ibl_incidence_tangent(n, r), 0.0);
+    }
+    return vec4(0.0);
+}
+
 vec4 row_value(int j, int i) {
+    if (j >= 18) return runtime_row(j, i);
     float x = u64(i);
     if (j == 0) { // default taps in 6 levels
         ibl_specular_taps t = ibl_specular_lookup_taps(x, 6, ibl_specular_default(6, 0, 6));

@@ -400,7 +400,42 @@ async function runNumericTest() {
     if (!gl) throw new Error('WebGL2 is not available');
     if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to read float results');
     const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('numeric.frag.glsl')));
-    const W = 64, H = 18;
+    const W = 64, H = 28;
+    // The runtime rows' fixtures (glsl_reference --fixtures): an RGBA32F chain, two RGBA32F tables.
+    if (!gl.getExtension('OES_texture_float_linear')) throw new Error('OES_texture_float_linear is needed to filter the fixtures');
+    const fx = JSON.parse(await fetchText(params.get('bake') + 'numeric_fixtures.json'));
+    const chain = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_CUBE_MAP, chain);
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    fx.chain.forEach((lv, l) => {
+        for (let f = 0; f < 6; ++f) {
+            const rgba = new Float32Array(4 * lv.size * lv.size);
+            for (let k = 0; k < lv.size * lv.size; ++k) {
+                for (let c = 0; c < 3; ++c) rgba[4 * k + c] = lv.faces[f][3 * k + c];
+                rgba[4 * k + 3] = 1;
+            }
+            gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, l, gl.RGBA32F, lv.size, lv.size, 0, gl.RGBA, gl.FLOAT, rgba);
+        }
+    });
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_BASE_LEVEL, 0);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAX_LEVEL, fx.chain.length - 1);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MIN_FILTER, gl.LINEAR_MIPMAP_LINEAR);
+    gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    for (const w of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(gl.TEXTURE_CUBE_MAP, w, gl.CLAMP_TO_EDGE);
+    const table = (unit, values) => {
+        const t = gl.createTexture();
+        gl.activeTexture(gl.TEXTURE0 + unit);
+        gl.bindTexture(gl.TEXTURE_2D, t);
+        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, fx.taps.size, fx.taps.size, 0, gl.RGBA, gl.FLOAT, new Float32Array(values));
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_S, gl.CLAMP_TO_EDGE);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_WRAP_T, gl.CLAMP_TO_EDGE);
+    };
+    table(1, fx.taps.a);
+    table(2, fx.taps.b);
+    gl.activeTexture(gl.TEXTURE3); // the render target below binds here, on no sampler's unit
     const fb = gl.createFramebuffer(), tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, W, H, 0, gl.RGBA, gl.FLOAT, null);
@@ -408,6 +443,9 @@ async function runNumericTest() {
     gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
     gl.viewport(0, 0, W, H);
     gl.useProgram(program);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_chain'), 0);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_taps_a'), 1);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_taps_b'), 2);
     gl.bindVertexArray(gl.createVertexArray());
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     const out = new Float32Array(4 * W * H);
