@@ -47,6 +47,7 @@
 #include <ibl/integrate/lookup_error.hpp>
 #include <ibl/integrate/prefilter.hpp>
 #include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/integrate/reference.hpp>
 #include <ibl/runtime.hpp>
 
 #if defined(IBL_EXAMPLES_DATA_DIR)
@@ -83,6 +84,9 @@ struct products {
     const ibl::lobe_lut* lobe_fit_nl = nullptr;
     const ibl::lobe_taps_lut* taps2_g1 = nullptr;
     const ibl::lobe_taps_lut* taps3_g1 = nullptr;
+    /// The G1-weighted LD of the environment itself at (dir, r) (GGX IS in double, 8192 samples;
+    /// fit mode: the mixtures read without the chain's storage and interpolation).
+    std::function<d3(const d3&, double)> exact_ld;
 };
 
 struct shading_point {
@@ -125,38 +129,49 @@ f3 fis(const ibl::cubemap<float>& chain, const products& p, const shading_point&
 int g_levels = 6;    ///< chain levels (levels=N on the command line)
 double g_leak = 0.0; ///< leak_weight of the per-cell fits (leak=X)
 
-/// Fitted mixtures per (r, n.v) cell and tap count (index [count - 1][r][mu]).
+/// Fitted mixtures per (r, n.v) cell and tap count (index [kernels][count - 1][r][mu]; kernels 0:
+/// of any roughness, 1: the chain's stored levels read by one trilinear textureLod each).
 struct fitted_cells {
-    std::vector<ibl::lobe_mixture> m[6];
-    const ibl::lobe_mixture& at(int count, const shading_point& s) const {
+    std::vector<ibl::lobe_mixture> m[2][6];
+    const ibl::lobe_mixture& at(int count, bool levels, const shading_point& s) const {
         int ir = 0, im = 0;
         for (int i = 0; i < n_r; ++i)
             if (std::fabs(float(k_roughness[i]) - s.roughness) < 1e-6f) ir = i;
         for (int i = 0; i < n_mu; ++i)
             if (std::fabs(float(k_n_dot_v[i]) - s.n_dot_v) < 1e-6f) im = i;
-        return m[count - 1][std::size_t(ir * n_mu + im)];
+        return m[levels ? 1 : 0][count - 1][std::size_t(ir * n_mu + im)];
     }
 };
 fitted_cells g_fits;
 
-void make_fits(ibl::ld_weight w) {
-    for (int c : {1, 2, 3, 6}) {
-        g_fits.m[c - 1].assign(std::size_t(n_r * n_mu), {});
-        ibl::thread_executor{2}(std::size_t(n_r * n_mu), [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-                ibl::lobe_fit_options o;
-                o.taps = c;
-                o.nodes = 32;
-                o.iterations = 150;
-                o.leak_weight = g_leak;
-                g_fits.m[c - 1][i] = ibl::fit_specular_lobe<model>(k_n_dot_v[i % n_mu], k_roughness[i / n_mu], w, o);
-            }
-        });
-    }
+std::vector<double> chain_level_roughness() {
+    std::vector<double> r(static_cast<std::size_t>(g_levels));
+    for (int l = 0; l < g_levels; ++l) r[std::size_t(l)] = double(l) / double(g_levels - 1);
+    return r;
 }
 
-f3 mixture(const ibl::cubemap<float>& chain, const products& p, const shading_point& s, int count) {
-    const ibl::lobe_mixture& mx = g_fits.at(count, s);
+void make_fits(ibl::ld_weight w) {
+    for (int lv = 0; lv < 2; ++lv)
+        for (int c : {1, 2, 3, 6}) {
+            g_fits.m[lv][c - 1].assign(std::size_t(n_r * n_mu), {});
+            ibl::thread_executor{2}(std::size_t(n_r * n_mu), [&](std::size_t b, std::size_t e) {
+                for (std::size_t i = b; i < e; ++i) {
+                    ibl::lobe_fit_options o;
+                    o.taps = c;
+                    o.nodes = 32;
+                    o.iterations = 150;
+                    o.leak_weight = g_leak;
+                    if (lv == 1) o.level_roughness = chain_level_roughness();
+                    g_fits.m[lv][c - 1][i] = ibl::fit_specular_lobe<model>(k_n_dot_v[i % n_mu], k_roughness[i / n_mu], w, o);
+                }
+            });
+        }
+}
+
+f3 mixture(const ibl::cubemap<float>& chain, const products& p, const shading_point& s, int count, bool levels = false,
+           bool exact = false) {
+    const ibl::lobe_mixture& mx = g_fits.at(count, levels, s);
+    const ibl::specular_lookup_desc textbook = ibl::specular_lookup_desc::textbook();
     const f3 r_dir = reflect_dir(s);
     f3 t = r_dir - glm::dot(s.n, r_dir) * s.n;
     const float tl = glm::length(t);
@@ -165,20 +180,15 @@ f3 mixture(const ibl::cubemap<float>& chain, const products& p, const shading_po
     for (int k = 0; k < mx.count; ++k) {
         const auto& tp = mx.taps[std::size_t(k)];
         const f3 d = float(std::cos(tp.angle)) * s.n + float(std::sin(tp.angle)) * t;
-        sum += float(tp.weight) * ibl::specular_lookup(chain, d, float(tp.roughness), k_lookup);
+        sum += float(tp.weight) * (exact    ? f3(p.exact_ld(d3(d), tp.roughness))
+                                   : levels ? ibl::specular_lookup(chain, d, float(tp.roughness / (g_levels - 1)), textbook)
+                                            : ibl::specular_lookup(chain, d, float(tp.roughness), k_lookup));
     }
     return sum * albedo_of(p, s);
 }
 
-std::vector<variant> make_fit_variants() {
-    std::vector<variant> v;
-    v.push_back({"split sum, G1 chain", "2 + 1", [](const products& p, const shading_point& s) {
-                     return split(p.chain_g1, p, s, reflect_dir(s));
-                 }});
-    v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
-                                               f3(1.0f));
-                 }});
+/// The fitted tables (G1 chain): one tap (the lobe LUT format), 2 and 3 taps.
+void add_fitted_table_variants(std::vector<variant>& v) {
     v.push_back({"fitted lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
                      return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, k_layout, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
@@ -191,10 +201,43 @@ std::vector<variant> make_fit_variants() {
                      return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, k_layout, s.n, s.v, s.roughness, s.f0,
                                                     f3(1.0f));
                  }});
+}
+
+std::vector<variant> make_fit_variants() {
+    std::vector<variant> v;
+    v.push_back({"split sum, G1 chain", "2 + 1", [](const products& p, const shading_point& s) {
+                     return split(p.chain_g1, p, s, reflect_dir(s));
+                 }});
+    v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                                               f3(1.0f));
+                 }});
+    add_fitted_table_variants(v);
     v.push_back({"L1 fit 1 tap, G1", "2 + 1", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 1); }});
     v.push_back({"L1 fit 2 taps, G1", "4 + 2", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 2); }});
     v.push_back({"L1 fit 3 taps, G1", "6 + 3", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 3); }});
     v.push_back({"L1 fit 6 taps, G1", "12 + 5", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 6); }});
+    v.push_back({"L1 fit 1 tap, exact LD", "-", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 1, false, true);
+                 }});
+    v.push_back({"L1 fit 2 taps, exact LD", "-", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 2, false, true);
+                 }});
+    v.push_back({"L1 fit 6 taps, exact LD", "-", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 6, false, true);
+                 }});
+    v.push_back({"L1 fit 1 tap, stored levels, G1", "1 + 1", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 1, true);
+                 }});
+    v.push_back({"L1 fit 2 taps, stored levels, G1", "2 + 2", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 2, true);
+                 }});
+    v.push_back({"L1 fit 3 taps, stored levels, G1", "3 + 3", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 3, true);
+                 }});
+    v.push_back({"L1 fit 6 taps, stored levels, G1", "6 + 5", [](const products& p, const shading_point& s) {
+                     return mixture(p.chain_g1, p, s, 6, true);
+                 }});
     v.push_back({"FIS 16, normalised, G1", "16 + 1", [](const products& p, const shading_point& s) {
                      return fis(p.chain_g1, p, s, 16, 1.0f, true);
                  }});
@@ -229,18 +272,7 @@ std::vector<variant> make_variants(bool explore) {
                      return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_fit_nl, k_layout, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
-    v.push_back({"fitted lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, k_layout, s.n, s.v, s.roughness, s.f0,
-                                               f3(1.0f));
-                 }});
-    v.push_back({"fitted 2 taps LUT, G1", "4 + 2", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps2_g1, k_layout, s.n, s.v, s.roughness, s.f0,
-                                                    f3(1.0f));
-                 }});
-    v.push_back({"fitted 3 taps LUT, G1", "6 + 3", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, k_layout, s.n, s.v, s.roughness, s.f0,
-                                                    f3(1.0f));
-                 }});
+    add_fitted_table_variants(v);
     v.push_back({"FIS 4, normalised, G1", "4 + 1", [](const products& p, const shading_point& s) {
                      return fis(p.chain_g1, p, s, 4, 1.0f, true);
                  }});
@@ -486,6 +518,9 @@ int main(int argc, char** argv) {
         p.lobe_fit_nl = &lobe_fit_nl;
         p.taps2_g1 = &taps2_g1;
         p.taps3_g1 = &taps3_g1;
+        p.exact_ld = [&integrand](const d3& dir, double r) {
+            return ibl::reference_ld(integrand, dir, r, 8192, ibl::ld_weight::g1);
+        };
         std::printf("%s: chains baked %.1f s\n", name.c_str(), seconds_since(t1));
         results.push_back({name, measure(integrand, dist, p, vars, points, ref_samples)});
         std::printf("%s: measured %.1f s\n", name.c_str(), seconds_since(t1));
@@ -548,9 +583,10 @@ int main(int argc, char** argv) {
                     where.c_str(), cnt > 0 ? 100.0 * std::sqrt(pooled / cnt) : 0.0, 100.0 * nworst,
                     cnt > 0 ? 100.0 * std::sqrt(npooled / cnt) : 0.0);
     }
+    // Per-cell tables: a few variants, every variant in fit mode.
     for (const env_result& e : results)
-        for (const std::size_t q : {std::size_t(0), std::size_t(3), std::size_t(5), std::size_t(8)})
-            if (q < vars.size()) print_detail(e, vars, q, 0);
+        for (std::size_t q = 0; q < vars.size(); ++q)
+            if (fit_mode || q == 0 || q == 3 || q == 5 || q == 8) print_detail(e, vars, q, 0);
     std::printf("\ntotal time %.1f s\n", seconds_since(t0));
     return 0;
 }

@@ -253,7 +253,9 @@ template <class T> IBL_FUNC vec3<T> incidence_tangent(const vec3<T>& n, const ve
 }
 
 /// The fitted-taps model (integrate/lobe_fit.hpp) from a table with members size, channels, taps
-/// and data (lobe_taps_lut, continuous taps): at (n.v, r) one bilinear read of the channels
+/// and data (lobe_taps_lut fitted with kernels of any roughness, i.e. empty level_roughness: a
+/// table of stored levels holds lods there, which this does not read): at (n.v, r) one bilinear
+/// read of the channels
 /// (A, B, then angle / (pi/2), roughness, weight per tap), then
 ///     Lo_s ~ (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k)
 /// with t = incidence_tangent(n, R) and each LD by the chain lookup sd. Cost: taps chain lookups

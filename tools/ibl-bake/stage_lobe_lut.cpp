@@ -2,8 +2,8 @@
 // ibl/runtime.hpp, integrate/lobe_fit.hpp): per (n.v, r) the DFG terms A, B, the lerp factor s
 // and the chain roughness r_eff of the one chain kernel closest to the specular lobe in L1
 // (ibl::make_lobe_lut_fitted, the chain's weight), in the DFG table's layout at
-// lobe_lut_size_for(DFG size) texels per side. The fit marches each row from n.v = 1 with the
-// neighbour's answer as its start (about 0.5 ms a texel and thread).
+// lobe_lut_size_for(DFG size) texels per side (each texel fitted on its own, about 1 ms a texel
+// and thread).
 // Checks: (A, B) against the DFG table read (ibl::dfg_lookup) at the lobe LUT's texels; at the
 // midpoints of every second cell per axis, the L1 distance to the lobe of the tap read bilinearly
 // (ibl::lobe_lut_lookup) against that of a direct fit there (what the table's interpolation

@@ -19,8 +19,8 @@
 // of nodes^2 points, weights f (n.l) / pdf_l). A kernel that reaches below the horizon loses
 // that mass from the lobe's support, so the L1 fit trades width against leakage by itself; the
 // first-moment match of integrate/lobe_lut.hpp does not see the horizon at all.
-// The fit is a Nelder-Mead search from the moment solution (and spread starts for 2 and 3
-// taps); it is derived from the BRDF alone, nothing is fitted to an environment. Weights summing
+// The fit is a Nelder-Mead search from the moment solution, k taps from the fitted k - 1 with the
+// heaviest tap split in two; it is derived from the BRDF alone, nothing is fitted to an environment. Weights summing
 // to 1 keep the white furnace: a constant environment gives exactly (F0 A + F90 B) L.
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
@@ -322,8 +322,7 @@ double nelder_mead(F&& f, std::vector<double>& x0, const std::vector<double>& st
 /// (header). Starts: the one-tap moment match; k taps start from the fitted k - 1 taps with the
 /// heaviest tap split in two along the plane of incidence (a greedy continuation).
 template <class Model = ggx_height_correlated>
-lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, const lobe_fit_options& o = {},
-                               const lobe_mixture* start = nullptr) {
+lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, const lobe_fit_options& o = {}) {
     lobe_mixture out;
     const int n_taps = std::clamp(o.taps, 1, lobe_max_taps);
     const double mu = clamp(n_dot_v, 1e-3, std::cos(lobe_min_theta)), r = saturate(roughness);
@@ -348,15 +347,8 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     }
     const double spread = 0.5 * std::max(r_eff * r_eff, 0.02);
     double best = 2.0;
-    int first = 1;
-    if (start && start->count == n_taps) { // warm start: the neighbour's taps
-        x.clear();
-        for (int k = 0; k < n_taps; ++k)
-            x.insert(x.end(), {start->taps[std::size_t(k)].angle, start->taps[std::size_t(k)].roughness, start->taps[std::size_t(k)].weight});
-        first = n_taps;
-    }
-    for (int nk = first; nk <= n_taps; ++nk) {
-        if (nk > first) { // split the heaviest tap
+    for (int nk = 1; nk <= n_taps; ++nk) {
+        if (nk > 1) { // split the heaviest tap
             int h = 0;
             for (int k = 1; k < nk - 1; ++k)
                 if (x[std::size_t(3 * k + 2)] > x[std::size_t(3 * h + 2)]) h = k;
@@ -404,9 +396,7 @@ struct lobe_taps_lut {
     double max_l1 = 0.0, mean_l1 = 0.0; ///< of the fits at the texels with r >= 0.05 and A + B > 0
 };
 
-/// Fits every texel (header): rows in parallel, each row marched from n.v = 1 down with the
-/// previous texel's taps as the start (continuous taps, so bilinear reads between texels blend
-/// like taps). size in [1, 256].
+/// Fits every texel (header; rows in parallel) by fit_specular_lobe. size in [1, 256].
 template <class Model = ggx_height_correlated, class Executor = thread_executor>
 lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, const lobe_fit_options& o = {},
                                  Executor&& ex = Executor{}) {
@@ -425,7 +415,6 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {
             const double r = dfg_texel_value<double>(layout.roughness, std::uint32_t(j), size, layout.edge_aligned);
-            lobe_mixture prev;
             for (std::uint32_t ii = size; ii-- > 0;) {
                 const double mu = dfg_texel_value<double>(layout.n_dot_v, ii, size, layout.edge_aligned);
                 float* t = &lut.data[(j * size + ii) * lut.channels];
@@ -437,8 +426,10 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
                     t[4] = 1.0f;
                     continue;
                 }
-                const lobe_mixture m = fit_specular_lobe<Model>(mu, r, w, o, prev.count > 0 ? &prev : nullptr);
-                prev = m;
+                // Each texel by the greedy fit from its own moments. (Starting from the neighbour's
+                // taps instead drifts into worse minima: mean L1 0.80 against 0.71 for one tap,
+                // 0.70 against 0.58 for two, and never gained more than 0.01 on a texel.)
+                const lobe_mixture m = fit_specular_lobe<Model>(mu, r, w, o);
                 // statistics: not the n.v = 0 column (no lobe) nor the near-mirror rows r < 0.05 (the
                 // kernels' roughness floor 0.01 is wider than those lobes; the chain reads level 0)
                 if (t[0] + t[1] > 1e-6f && r >= 0.05) l1[j * size + ii] = m.l1;
