@@ -326,8 +326,9 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     lobe_mixture out;
     const int n_taps = std::clamp(o.taps, 1, lobe_max_taps);
     const double mu = clamp(n_dot_v, 1e-3, std::cos(lobe_min_theta)), r = saturate(roughness);
-    const lobe_moments m = specular_lobe_moments<Model>(mu, r, 64);
-    const double r_eff = std::max(ld_matched_roughness(m.rho, w), 0.01);
+    // the start (and the moment match reported beside the fit): coarse quadratures suffice
+    const lobe_moments m = specular_lobe_moments<Model>(mu, r, 32);
+    const double r_eff = std::max(ld_matched_roughness(m.rho, w, 256), 0.01);
     const detail::lobe_points pts = detail::make_lobe_points<Model>(mu, r, o.nodes);
     const bool lv = !o.level_roughness.empty();
     const double vmax = lv ? double(o.level_roughness.size() - 1) : 1.0;
