@@ -5,8 +5,9 @@
 // ---- The visibility model -----------------------------------------------------------------------
 //   A shading point at normal n sees the environment only inside a cone of half-angle theta_o in
 //   [0, pi] about a unit axis b (the bent normal): V(l) = 1 if b.l >= cos theta_o, else 0.
-//   b = cos(beta) n + sin(beta) t, beta in [0, pi/2] the tilt and t a unit tangent (make_bent_cone
-//   takes t in the plane of incidence, towards the mirror direction R for beta > 0).
+//   b = cos(beta) n + sin(beta) t, |beta| <= pi/2 the tilt and t a unit tangent (make_bent_cone
+//   takes t in the plane of incidence towards the mirror direction R: beta > 0 tilts the cone
+//   towards R, beta < 0 away from it, towards v). The ambient occlusion depends on |beta| only.
 //
 // ---- Ambient occlusion of the cone (ambient_occlusion_cone) -----------------------------------
 //   ao = (1/pi) integral_{cone, n.l > 0} (n.l) dl, the cosine-weighted visible fraction.
@@ -46,7 +47,7 @@
 //   cell's samples by l.z once and reads every ao threshold cos theta_o = sqrt(1 - ao) from the
 //   prefix sums.
 //
-// Domains: unit n, v (n.v clamped to [0, 1] as in reference_radiance); tilt in [0, pi/2],
+// Domains: unit n, v (n.v clamped to [0, 1] as in reference_radiance); tilt in [-pi/2, pi/2],
 // half-angle in [0, pi] (clamped); ao in [0, 1] (clamped).
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
@@ -87,12 +88,12 @@ struct visibility_cone {
 };
 
 /// The cone about b = cos(tilt) n + sin(tilt) t, t the unit tangent of n in the plane of incidence
-/// towards R = reflect(-v, n) (the frame's tangent when v = n). tilt clamped to [0, pi/2].
+/// towards R = reflect(-v, n) (the frame's tangent when v = n). tilt clamped to [-pi/2, pi/2].
 inline visibility_cone make_bent_cone(const vec3<double>& n, const vec3<double>& v, double tilt, double half_angle) {
     vec3<double> t = -(v - glm::dot(n, v) * n);
     const double len = glm::length(t);
     t = len > 1e-12 ? t / len : make_frame(n).t;
-    const double b = clamp(tilt, 0.0, 0.5 * pi_v<double>);
+    const double b = clamp(tilt, -0.5 * pi_v<double>, 0.5 * pi_v<double>);
     return {std::cos(b) * n + std::sin(b) * t, clamp(half_angle, 0.0, pi_v<double>)};
 }
 
@@ -107,9 +108,9 @@ inline double clipped_ring(double a, double c) noexcept {
 } // namespace detail
 
 /// Ambient occlusion (cosine-weighted visible fraction, header) of a cone of half-angle theta_o
-/// whose axis is tilted by beta from the normal; nodes Gauss-Legendre points per smooth piece.
+/// whose axis is tilted by |tilt| (clamped to pi/2) from the normal; nodes Gauss-Legendre points.
 inline double ambient_occlusion_cone(double tilt, double half_angle, std::uint32_t nodes = 32) {
-    const double beta = clamp(tilt, 0.0, 0.5 * pi_v<double>);
+    const double beta = std::min(std::fabs(tilt), 0.5 * pi_v<double>);
     const double to = clamp(half_angle, 0.0, pi_v<double>);
     if (to <= 0.5 * pi_v<double> - beta) return std::cos(beta) * sqr(std::sin(to));
     if (to >= 0.5 * pi_v<double> + beta) return 1.0;
@@ -129,11 +130,11 @@ inline double ambient_occlusion_cone(double tilt, double half_angle, std::uint32
     return clamp(sum * inv_pi_v<double>, 0.0, 1.0);
 }
 
-/// The half-angle theta_o in [0, pi/2 + tilt] whose cone has ambient occlusion ao (bisection,
+/// The half-angle theta_o in [0, pi/2 + |tilt|] whose cone has ambient occlusion ao (bisection,
 /// 60 steps; closed form asin(sqrt(ao)) at tilt 0). ao clamped to [0, 1].
 inline double cone_half_angle_for_ao(double ao, double tilt = 0.0, std::uint32_t nodes = 32) {
     const double a = saturate(ao);
-    const double beta = clamp(tilt, 0.0, 0.5 * pi_v<double>);
+    const double beta = std::min(std::fabs(tilt), 0.5 * pi_v<double>);
     if (beta == 0.0) return std::asin(std::sqrt(a));
     double lo = 0.0, hi = 0.5 * pi_v<double> + beta;
     for (int it = 0; it < 60; ++it) {
