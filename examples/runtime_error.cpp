@@ -5,7 +5,7 @@
 //
 //   runtime_error [quick|explore|fit] [levels=N]
 //     quick: 8 points per cell, 2^13 reference samples (a smoke run); explore: FIS footprint
-//     scales; fit: the per-cell L1 fits of 1, 2, 3 and 6 taps (integrate/lobe_fit.hpp, no table)
+//     scales; fit: the per-cell L1 fits of 1, 2, 3, 6 and 8 taps (integrate/lobe_fit.hpp, no table)
 //     against their 32^2 tables; levels=N: a chain of N levels (default 6, as ibl-bake).
 //
 // Environments: the built-in sky + sun (ibl::make_default_sky; integrand analytic) and
@@ -132,7 +132,7 @@ double g_leak = 0.0; ///< leak_weight of the per-cell fits (leak=X)
 /// Fitted mixtures per (r, n.v) cell and tap count (index [kernels][count - 1][r][mu]; kernels 0:
 /// of any roughness, 1: the chain's stored levels read by one trilinear textureLod each).
 struct fitted_cells {
-    std::vector<ibl::lobe_mixture> m[2][6];
+    std::vector<ibl::lobe_mixture> m[2][8];
     const ibl::lobe_mixture& at(int count, bool levels, const shading_point& s) const {
         int ir = 0, im = 0;
         for (int i = 0; i < n_r; ++i)
@@ -152,7 +152,8 @@ std::vector<double> chain_level_roughness() {
 
 void make_fits(ibl::ld_weight w) {
     for (int lv = 0; lv < 2; ++lv)
-        for (int c : {1, 2, 3, 6}) {
+        for (int c : {1, 2, 3, 6, 8}) {
+            if (lv == 1 && c == 8) continue;
             g_fits.m[lv][c - 1].assign(std::size_t(n_r * n_mu), {});
             ibl::thread_executor{2}(std::size_t(n_r * n_mu), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i) {
@@ -217,6 +218,7 @@ std::vector<variant> make_fit_variants() {
     v.push_back({"L1 fit 2 taps, G1", "4 + 2", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 2); }});
     v.push_back({"L1 fit 3 taps, G1", "6 + 3", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 3); }});
     v.push_back({"L1 fit 6 taps, G1", "12 + 5", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 6); }});
+    v.push_back({"L1 fit 8 taps, G1", "16 + 7", [](const products& p, const shading_point& s) { return mixture(p.chain_g1, p, s, 8); }});
     v.push_back({"L1 fit 1 tap, exact LD", "-", [](const products& p, const shading_point& s) {
                      return mixture(p.chain_g1, p, s, 1, false, true);
                  }});
