@@ -6,6 +6,7 @@ uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
 uniform sampler2D u_lut;
 uniform sampler2D u_taps_a, u_taps_b;
+uniform highp sampler3D u_so;
 uniform int u_taps;
 uniform vec3 u_sh[9];
 uniform vec3 u_n, u_v, u_l;
@@ -50,5 +51,7 @@ void main() {
     vec3 it = ibl_incidence_tangent(u_n, u_l);
     vec3 lt = ibl_specular_lobe_taps2(u_chain, sd, u_taps_a, u_taps_b, lay, u_n, u_v, u_r, m.f0, m.f90) +
               ibl_lobe_tap_direction(u_n, it, 0.5);
-    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt, 1.0);
+    float so = ibl_specular_occlusion_table(u_so, dot(u_n, u_v), u_r, 0.5) +
+               ibl_specular_occlusion_bent(u_so, u_n, u_v, it, u_r, 0.5) + ibl_specular_occlusion_coord(0.5, u_r, 0.5, 8).z;
+    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so, 1.0);
 }

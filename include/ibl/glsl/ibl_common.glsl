@@ -1,7 +1,8 @@
 // ibl/glsl/ibl_common.glsl — conventions and helpers shared by the GLSL mirror of the library's
 // runtime (ibl/lookup.hpp, ibl/shade.hpp, ibl/sh/convolve.hpp). Valid as GLSL ES 3.00 (WebGL2)
 // and GLSL 4.50; no #version line: the including shader writes it (and, in ES, the precision
-// statements: `precision highp float; precision highp int; precision highp samplerCube;`).
+// statements: `precision highp float; precision highp int; precision highp samplerCube;`, and
+// `precision highp sampler3D;` where a shader declares the occlusion table's sampler).
 // Concatenate in this order (GLSL has no #include): ibl_common.glsl, then any of
 // ibl_lookup.glsl, ibl_sh.glsl, ibl_shade.glsl, ibl_runtime.glsl (each guards itself against a
 // second inclusion; ibl_runtime.glsl needs ibl_lookup.glsl and ibl_shade.glsl).
@@ -44,6 +45,14 @@
 //           (R = weight0, G = angle1 / (pi/2), B = roughness1, A = weight1); tap k reads the
 //           chain at cos(angle_k) n + sin(angle_k) t (t: the tangent of n towards R) and roughness_k.
 //           Clamp to edge, bilinear (RGBA32F: the table's floats).
+// SO LUT    the specular-occlusion table of ibl/occlusion.hpp (specular_occlusion_lut, size^3
+//           floats at index (k size + j) size + i) as a size^3 3-D texture, one channel (R32F;
+//           R16F where OES_texture_float_linear is missing), uploaded as stored: texImage3D's x =
+//           i = n.v, y = j = r, z = k = ao (layer k = the k-th size^2 slice), texel (i, j, k) at
+//           n.v = i / (size - 1), r = j / (size - 1), ao = k / (size - 1) (edge aligned).
+//           Clamp to edge (S, T and R), MIN and MAG_FILTER LINEAR, one level. The functions take
+//           a highp sampler3D (GLSL ES has no default precision for sampler3D: declare the
+//           uniform highp or add `precision highp sampler3D;`).
 // SH        nine shader constants c_k (sh.json "irradiance_over_pi_shader") with
 //           E(n)/pi = sum c_k p_k(n), p = (1, y, z, x, xy, yz, 3z^2 - 1, xz, x^2 - y^2).
 // Radiance  linear, the units of the source; E/pi is the cosine-weighted mean radiance (a

@@ -1,15 +1,20 @@
 // ibl/glsl/ibl_runtime.glsl — the runtime variants of the specular term (GLSL mirror of
 // ibl/runtime.hpp, with the pieces of core/frame.hpp, sampling/sequence.hpp and
 // sampling/ggx.hpp they use): Frostbite's dominant direction, horizon fading and Lagarde's
-// specular occlusion; runtime filtered importance sampling of the chain (K taps along the GGX
-// visible-normal lobe, each read at its footprint's roughness); the fitted-taps model of
-// integrate/lobe_fit.hpp in its two-tap form (two RGBA tables, ibl_common.glsl). The formulas
-// and their derivations are in runtime.hpp's header; every function here is the same expression
-// in the same order. Needs ibl_common.glsl, ibl_lookup.glsl and ibl_shade.glsl first.
+// specular occlusion; the specular-occlusion table of ibl/occlusion.hpp (a 3-D texture,
+// ibl_common.glsl) read about n or about a bent normal; runtime filtered importance sampling of
+// the chain (K taps along the GGX visible-normal lobe, each read at its footprint's roughness);
+// the fitted-taps model of integrate/lobe_fit.hpp in its two-tap form (two RGBA tables,
+// ibl_common.glsl). The formulas and their derivations are in runtime.hpp's and occlusion.hpp's
+// headers; every function here is the same expression in the same order. Needs
+// ibl_common.glsl, ibl_lookup.glsl and ibl_shade.glsl first.
 //
 // Differences from the C++: make_frame's sign(n.z) is copysign(1, n.z) in the C++ and
 // (n.z >= 0 ? 1 : -1) here (they differ only at n.z = -0); ibl_specular_fis takes at most
-// IBL_FIS_MAX_TAPS taps (the C++ has no cap).
+// IBL_FIS_MAX_TAPS taps (the C++ has no cap). The bent-normal reading of the occlusion table has
+// no C++ function: it is the expression docs/occlusion.md measures as "lobe LUT, bent"
+// (examples/occlusion_error.cpp). The table is read by the texture unit's trilinear filter, not
+// by the C++'s float weights (docs/shaders.md bounds the difference).
 
 #ifndef IBL_GLSL_RUNTIME
 #define IBL_GLSL_RUNTIME 1
@@ -49,6 +54,37 @@ float ibl_specular_occlusion_lagarde(float n_dot_v, float ambient_occlusion, flo
     float r = ibl_saturate(roughness);
     float a = r * r;
     return ibl_saturate(pow(ibl_saturate(n_dot_v) + ao, exp2(-16.0 * a - 1.0)) - 1.0 + ao);
+}
+
+// ---- specular occlusion table (ibl/occlusion.hpp) ------------------------------------------------
+
+// Sampler coordinate of (n.v, r, ao) in a size^3 edge-aligned table (ibl_common.glsl, SO LUT):
+// (x (size - 1) + 0.5) / size per axis, inputs clamped to [0, 1]; with clamp-to-edge and linear
+// filtering, texture() at it is specular_occlusion_table's trilinear read.
+vec3 ibl_specular_occlusion_coord(float n_dot_v, float roughness, float ambient_occlusion, int size) {
+    vec3 x = ibl_saturate(vec3(n_dot_v, roughness, ambient_occlusion));
+    return (x * float(size - 1) + 0.5) / float(size);
+}
+
+// The visible fraction of the specular lobe in the cone about n that ao implies, read from the
+// table (specular_occlusion_table): inputs clamped to [0, 1], result clamped to [0, 1]; a table
+// smaller than 2^3 reads 1 (no occlusion). Multiplies the specular term (Fresnel free).
+float ibl_specular_occlusion_table(highp sampler3D so, float n_dot_v, float roughness, float ambient_occlusion) {
+    int size = textureSize(so, 0).x;
+    if (size < 2) return 1.0;
+    return ibl_saturate(textureLod(so, ibl_specular_occlusion_coord(n_dot_v, roughness, ambient_occlusion, size), 0.0).r);
+}
+
+// The same table read about a bent normal b (the visible cone's axis; unit n, v, b): the lobe's
+// direction measured from b and the aperture from ao without the horizon clip,
+// so(saturate(b.R), r, b.n > 0 ? min(1, ao / b.n) : 1), R = 2 (n.v) n - v. At b = n it is
+// ibl_specular_occlusion_table(so, n.v, r, ao) for n.v >= 0.
+float ibl_specular_occlusion_bent(highp sampler3D so, vec3 n, vec3 v, vec3 bent_normal, float roughness,
+                                  float ambient_occlusion) {
+    vec3 r = 2.0 * dot(n, v) * n - v;
+    float b_r = ibl_saturate(dot(bent_normal, r));
+    float b_n = dot(bent_normal, n);
+    return ibl_specular_occlusion_table(so, b_r, roughness, b_n > 0.0 ? min(1.0, ambient_occlusion / b_n) : 1.0);
 }
 
 // ---- tangent frame (core/frame.hpp) ----------------------------------------------------------------
