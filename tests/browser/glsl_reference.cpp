@@ -13,7 +13,9 @@
 
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
+#include <ibl/integrate/occlusion.hpp>
 #include <ibl/lookup.hpp>
+#include <ibl/occlusion.hpp>
 #include <ibl/runtime.hpp>
 #include <ibl/shade.hpp>
 #include <ibl/sh/convolve.hpp>
@@ -371,7 +373,219 @@ float taps_r(int i) { return i % 4 == 0 ? 0.0f : u64(i); }
 ibl::vec2<float> fis_dfg(int i) { return {0.125f + float(i % 8) * 0.0625f, float(i / 8) * 0.03125f}; }
 v3 fis_f0(int i) { return v3(0.04f + 0.0625f * float(i % 8), 0.5f, 1.0f); }
 
+// ---- the occlusion rows (tools/viewer/numeric.frag.glsl: u_so) ----------------------------------
+
+/// The occlusion rows' table: make_specular_occlusion_lut 8^3 with 32^2 VNDF points per (n.v, r)
+/// cell (coarse, a few ms; the rows compare the reads, not the table's accuracy). It has the
+/// near-mirror step, so neighbouring texels differ by up to ~1 and filtering errors show.
+const ibl::specular_occlusion_lut& fixture_so() {
+    static const ibl::specular_occlusion_lut lut = ibl::make_specular_occlusion_lut(8, 32, ibl::serial_executor{});
+    return lut;
+}
+
+/// The table rows' inputs (n.v, r, ao), column c of case i: c = 0, 1 between texels (multiples of
+/// 1/64: never a texel centre k/7 but 0 and 1), c = 2 one axis at an edge (0 or 1), c = 3 one or
+/// more axes outside [0, 1] (-0.25 or 1.5: clamped).
+v3 so_point(int i, int c) {
+    if (c == 0) return {u64(i), u64((17 * i + 5) % 64), u64((29 * i + 11) % 64)};
+    if (c == 1) return {u64((41 * i + 7) % 64), u64((13 * i + 3) % 64), u64((7 * i + 1) % 64)};
+    if (c == 2) {
+        v3 p(u64((23 * i + 9) % 64), u64((37 * i + 2) % 64), u64((11 * i + 6) % 64));
+        p[i % 3] = (i / 3) % 2 == 0 ? 0.0f : 1.0f;
+        return p;
+    }
+    const float o = i % 2 == 0 ? -0.25f : 1.5f;
+    v3 p(u64((19 * i + 4) % 64), u64((31 * i + 8) % 64), u64((43 * i + 10) % 64));
+    if (i % 3 == 0) p.x = o;
+    if (i % 5 < 2) p.y = o;
+    if (i % 7 < 3) p.z = o;
+    return p;
+}
+
+/// ibl_specular_occlusion_coord: (saturate(x) (size - 1) + 0.5) / size per axis, in float.
+v3 so_coord(const v3& p, int size) {
+    const float s = float(size - 1), n = float(size);
+    return {(ibl::saturate(p.x) * s + 0.5f) / n, (ibl::saturate(p.y) * s + 0.5f) / n, (ibl::saturate(p.z) * s + 0.5f) / n};
+}
+
+float so_read(float n_dot_v, float r, float ao) {
+    return ibl::specular_occlusion_lookup(fixture_so(), n_dot_v, r, ao);
+}
+
+/// The bent-normal reading (docs/occlusion.md "lobe LUT, bent", examples/occlusion_error.cpp) in
+/// float: so(saturate(b.R), r, b.n > 0 ? min(1, ao / b.n) : 1), R = 2 (n.v) n - v. Also returns its
+/// table inputs.
+float so_bent(const v3& n, const v3& v, const v3& b, float r, float ao, v3* at = nullptr) {
+    const v3 rd = 2.0f * glm::dot(n, v) * n - v;
+    const float b_r = ibl::saturate(glm::dot(b, rd)), b_n = glm::dot(b, n);
+    const float a = b_n > 0.0f ? std::fmin(1.0f, ao / b_n) : 1.0f;
+    if (at) *at = v3(b_r, r, a);
+    return so_read(b_r, r, a);
+}
+
+/// The bent row's column c of case i: n = dir_of(i), v = dir_of((7 i + 3) mod 64), r = i / 64;
+/// c = 0: b = normalize(n + dir_of(63 - i) / 2), ao = ((13 i + 3) mod 64) / 64; c = 1: b = n (the
+/// plain reading); c = 2: b = -n (b.n < 0: ao' = 1); c = 3: b of c = 0 with ao = 31/32 (ao / b.n >= 1
+/// where b.n <= 31/32: ao' clamped to 1).
+struct bent_case {
+    v3 n, v, b;
+    float r, ao;
+};
+bent_case bent_case_of(int i, int c) {
+    bent_case k;
+    k.n = dir_of(i);
+    k.v = dir_of((7 * i + 3) % 64);
+    k.r = u64(i);
+    k.ao = c == 3 ? 0.96875f : u64((13 * i + 3) % 64);
+    k.b = c == 1 ? k.n : (c == 2 ? -k.n : glm::normalize(k.n + 0.5f * dir_of(63 - i)));
+    return k;
+}
+
+/// The filter probe's column a of case i: a texture coordinate whose texel-space position
+/// s N - 1/2 is exact in float, fractional along axis a only (a = 3: along all three) by
+/// f = ((4099 i) mod 2^16) / 2^16 (16 fraction bits: an 8-bit weight would be off by up to 2^-9).
+v3 probe_texel(int i, int a) {
+    const float f = float((4099 * i) % 65536) / 65536.0f, f2 = float((1237 * i + 77) % 65536) / 65536.0f,
+                f3 = float((3011 * i + 5) % 65536) / 65536.0f;
+    v3 t(float(i % 7), float((3 * i + 1) % 8), float((5 * i + 2) % 8));
+    if (a < 3) {
+        if (a != 0) t = v3(float((3 * i + 1) % 8), t.x, float((5 * i + 2) % 8));
+        if (a == 2) t = v3(float((3 * i + 1) % 8), float((5 * i + 2) % 8), float(i % 7));
+        t[a] += f;
+    } else {
+        t = v3(float(i % 7) + f, float((3 * i + 2) % 7) + f2, float((5 * i + 3) % 7) + f3);
+    }
+    return t; // texel-space position; the coordinate is (t + 1/2) / 8
+}
+
+/// Exact (double) trilinear value of the table at texel-space position t (clamped to the table).
+double so_exact(const v3& t) {
+    const auto& lut = fixture_so();
+    const int n = int(lut.size);
+    int i0[3];
+    double f[3];
+    for (int a = 0; a < 3; ++a) {
+        const double x = std::fmin(std::fmax(double(t[a]), 0.0), double(n - 1));
+        i0[a] = std::min(int(x), n - 2);
+        f[a] = x - double(i0[a]);
+    }
+    double out = 0.0;
+    for (int c = 0; c < 8; ++c) {
+        const int d[3] = {c & 1, (c >> 1) & 1, (c >> 2) & 1};
+        double w = 1.0;
+        for (int a = 0; a < 3; ++a) w *= d[a] ? f[a] : 1.0 - f[a];
+        out += w * double(lut.data[std::size_t(((i0[2] + d[2]) * n + (i0[1] + d[1])) * n + (i0[0] + d[0]))]);
+    }
+    return out;
+}
+
+/// The largest difference of neighbouring texels along each axis over the cells a read at
+/// (n.v, r, ao) may use: the cell of specular_occlusion_table and, where a fraction lies within
+/// 1e-3 of a cell boundary, the neighbouring cell (the GPU may round to it; the read is continuous).
+v3d so_cell_diffs(const v3& p) {
+    const auto& lut = fixture_so();
+    const int n = int(lut.size);
+    int lo[3], hi[3];
+    for (int a = 0; a < 3; ++a) {
+        const double x = double(ibl::saturate(p[a])) * double(n - 1);
+        const int i = std::min(int(x), n - 2);
+        const double f = x - double(i);
+        lo[a] = f < 1e-3 && i > 0 ? i - 1 : i;
+        hi[a] = f > 1.0 - 1e-3 && i < n - 2 ? i + 1 : i;
+    }
+    auto at = [&](int i, int j, int k) { return double(lut.data[std::size_t((k * n + j) * n + i)]); };
+    v3d d(0.0);
+    for (int k = lo[2]; k <= hi[2] + 1; ++k)
+        for (int j = lo[1]; j <= hi[1] + 1; ++j)
+            for (int i = lo[0]; i <= hi[0] + 1; ++i) {
+                if (i <= hi[0]) d.x = std::fmax(d.x, std::fabs(at(i + 1, j, k) - at(i, j, k)));
+                if (j <= hi[1]) d.y = std::fmax(d.y, std::fabs(at(i, j + 1, k) - at(i, j, k)));
+                if (k <= hi[2]) d.z = std::fmax(d.z, std::fabs(at(i, j, k + 1) - at(i, j, k)));
+            }
+    return d;
+}
+
+/// Error of the GPU's filter fraction against the C++'s f = fl(x (N - 1)) - i (N = 8): the shader
+/// forms s = (x (N - 1) + 1/2) / N (the product, possibly fused, and the sum each within half an
+/// ulp of values < 8: 2^-22; the division by 8 is exact) and the texture unit s N - 1/2 (exact: the
+/// operands share s N's ulp grid) and its fraction (exact). 2^-20 covers both with a factor 2.
+/// The filter's own weights are taken as float (measured: the probe row).
+constexpr double so_frac_eps = 1.0 / 1048576.0; // 2^-20
+
+/// A table read's absolute bound at (n.v, r, ao) whose inputs carry absolute errors din: per axis
+/// the largest texel difference times the fraction's error (so_frac_eps + (N - 1) din).
+double so_bound(const v3& p, const v3d& din) {
+    const v3d d = so_cell_diffs(p);
+    double e = 0.0;
+    for (int a = 0; a < 3; ++a) e += d[a] * (so_frac_eps + 7.0 * din[a]);
+    return e;
+}
+
+v4 occlusion_row(int j, int i) {
+    if (j == 28) {
+        const v3 c = so_coord(so_point(i, 0), 8);
+        return {c, so_coord(so_point(i, 3), 32).x};
+    }
+    if (j == 29) {
+        v4 o;
+        for (int c = 0; c < 4; ++c) {
+            const v3 p = so_point(i, c);
+            o[c] = so_read(p.x, p.y, p.z);
+        }
+        return o;
+    }
+    if (j == 30) {
+        v4 o;
+        for (int c = 0; c < 4; ++c) {
+            const bent_case k = bent_case_of(i, c);
+            o[c] = so_bent(k.n, k.v, k.b, k.r, k.ao);
+        }
+        return o;
+    }
+    if (j == 31) {
+        v4 o;
+        for (int a = 0; a < 4; ++a) o[a] = float(so_exact(probe_texel(i, a)));
+        return o;
+    }
+    return v4(0.0f);
+}
+
+/// The occlusion rows' per-value absolute bounds (the 1e-6 arithmetic floor plus what the
+/// fraction's error makes of the texel differences; the bent row adds its inputs' errors: b.R
+/// and b.n are dots of unit vectors formed in float on both sides, within 2^-21, and ao / b.n
+/// carries 2^-21 / b.n relative plus the division's 2^-22).
+bool occlusion_abs_bound(int j, int i, v4& out) {
+    if (j == 29) {
+        for (int c = 0; c < 4; ++c) out[c] = float(1e-6 + so_bound(so_point(i, c), v3d(0.0)));
+        return true;
+    }
+    if (j == 30) {
+        for (int c = 0; c < 4; ++c) {
+            const bent_case k = bent_case_of(i, c);
+            v3 at;
+            so_bent(k.n, k.v, k.b, k.r, k.ao, &at);
+            const float b_n = glm::dot(k.b, k.n);
+            const double eps = std::ldexp(1.0, -21);
+            const double da = b_n > 0.0f && at.z < 1.0f ? double(at.z) * (eps / double(b_n) + eps / 2.0) : 0.0;
+            out[c] = float(1e-6 + so_bound(at, v3d(eps, 0.0, da)));
+        }
+        return true;
+    }
+    return false;
+}
+
+/// The probe row's texel differences along its fractional axis (run_browser_test.py divides the
+/// error by them: the filter's effective weight error); column 3 (all axes) reports 0.
+double probe_dt(int i, int a) {
+    if (a == 3) return 0.0;
+    v3 t0 = probe_texel(i, a), t1 = t0;
+    t0[a] = std::floor(t0[a]);
+    t1[a] = t0[a] + 1.0f;
+    return so_exact(t1) - so_exact(t0);
+}
+
 v4 runtime_row(int j, int i) {
+    if (j >= 28) return occlusion_row(j, i);
     const float x = u64(i);
     if (j == 18) {
         const v3 g = dir_of(63 - i) * v3(1.0f, -1.0f, 1.0f);
@@ -561,6 +775,7 @@ struct row_info {
 /// The runtime rows' per-value absolute bounds (replacing the row's abs; the 1e-5 relative term
 /// stays): the arithmetic's 1e-6 plus what the errors of sin and of the inputs become (above).
 bool runtime_abs_bound(int j, int i, v4& out) {
+    if (j >= 28) return occlusion_abs_bound(j, i, out);
     const v4 base(1e-6f);
     if (j == 21) {
         out = base + vndf_bound(i);
@@ -593,7 +808,8 @@ bool runtime_abs_bound(int j, int i, v4& out) {
 }
 
 /// The fixtures as JSON for the page (run_browser_test.py serves them): the chain's levels (faces
-/// +X..-Z, rows from t = 0, RGB) and the two RGBA halves of the taps table.
+/// +X..-Z, rows from t = 0, RGB), the two RGBA halves of the taps table and the occlusion table
+/// (size^3 floats in specular_occlusion_lut's order: x = n.v fastest, then r, then ao).
 void print_fixtures() {
     const auto& chain = fixture_chain();
     std::printf("{\"chain\": [");
@@ -619,6 +835,9 @@ void print_fixtures() {
             for (int c = 0; c < 4; ++c)
                 std::printf("%s%.9g", k || c ? ", " : "", double(lut.data[k * 8 + std::size_t(4 * half + c)]));
     }
+    const auto& so = fixture_so();
+    std::printf("]}, \"so\": {\"size\": %u, \"data\": [", so.size);
+    for (std::size_t k = 0; k < so.data.size(); ++k) std::printf("%s%.9g", k ? ", " : "", double(so.data[k]));
     std::printf("]}}\n");
 }
 
@@ -667,6 +886,10 @@ int main(int argc, char** argv) {
         {"specular_fis (16, plain, c=2)", 1e-5, 0.0},
         {"specular_lobe_taps2", 1e-5, 0.0},
         {"incidence_tangent", 1e-5, 0.0},
+        {"so coord (8, 32)", 1e-5, 1e-6},
+        {"so table (8^3 R32F)", 1e-5, 0.0},
+        {"so bent", 1e-5, 0.0},
+        {"so filter probe (texel exact)", 1e-5, 1e-6},
     };
     const int n_rows = int(sizeof(rows) / sizeof(rows[0]));
     std::printf("{\"width\": %d, \"height\": %d, \"rows\": [", width, n_rows);
@@ -692,6 +915,13 @@ int main(int argc, char** argv) {
                 runtime_abs_bound(j, i, b);
                 std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", double(b.x), double(b.y), double(b.z), double(b.w));
             }
+            std::printf("]");
+        }
+        if (j == 31) { // the filter probe's texel differences (run_browser_test.py: effective weight error)
+            std::printf(", \"probe_dt\": [");
+            for (int i = 0; i < width; ++i)
+                std::printf("%s[%.9g, %.9g, %.9g, %.9g]", i ? ", " : "", probe_dt(i, 0), probe_dt(i, 1), probe_dt(i, 2),
+                            probe_dt(i, 3));
             std::printf("]");
         }
         std::printf("}");

@@ -385,6 +385,12 @@ def compare_numeric(reference_exe, result):
         abs_text = "per-value abs" if "abs_values" in row else f"{tol_abs:g}"
         print(f"{name:28s} {len(row['values'])} cases x 4: worst |diff| / bound {wmax:.3g} "
               f"(bound {abs_text} + {tol_rel:g} |C++|)")
+        if "probe_dt" in row:  # the texture unit's effective filter-weight error: |diff| / |texel difference|
+            ratios = [abs(vals[4 * (j * w + i) + c] - e[c]) / abs(dt[c])
+                      for i, (e, dt) in enumerate(zip(row["values"], row["probe_dt"])) for c in range(3)
+                      if abs(dt[c]) >= 1.0 / 16.0]
+            print(f"{'':28s} filter weight error max |diff| / |texel difference| {max(ratios):.3g} "
+                  f"over {len(ratios)} values with |difference| >= 1/16")
     print(f"renderer: {result.get('renderer')}")
     print("PASS" if ok else "FAIL")
     return ok

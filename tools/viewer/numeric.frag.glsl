@@ -3,10 +3,12 @@
 // evaluated by the C++ library is tests/browser/glsl_reference.cpp; the two must agree (the
 // inputs are built only from exact operations: multiples of 1/64, small integers). The runtime
 // rows read the reference's fixtures (glsl_reference --fixtures, uploaded by the page): an 8^2
-// RGBA32F chain of 4 levels and the two RGBA32F halves of a 4^2 two-tap table.
+// RGBA32F chain of 4 levels and the two RGBA32F halves of a 4^2 two-tap table; the occlusion
+// rows an 8^3 R32F specular-occlusion table (linear filtering).
 
 uniform samplerCube u_chain;
 uniform sampler2D u_taps_a, u_taps_b;
+uniform highp sampler3D u_so;
 out vec4 o_color;
 
 float u64(int i) { return i == 63 ? 1.0 : float(i) * 0.015625; } // i / 64, and 1 at the end
@@ -42,7 +44,68 @@ ibl_specular_desc chain_desc(bool textbook) {
     return ibl_specular_default(4, 0, 4);
 }
 
+// ---- the occlusion rows (glsl_reference.cpp: so_point, bent_case_of, probe_texel) ----
+
+vec3 so_point(int i, int c) {
+    if (c == 0) return vec3(u64(i), u64((17 * i + 5) % 64), u64((29 * i + 11) % 64));
+    if (c == 1) return vec3(u64((41 * i + 7) % 64), u64((13 * i + 3) % 64), u64((7 * i + 1) % 64));
+    if (c == 2) { // one axis at an edge
+        vec3 p = vec3(u64((23 * i + 9) % 64), u64((37 * i + 2) % 64), u64((11 * i + 6) % 64));
+        float e = (i / 3) % 2 == 0 ? 0.0 : 1.0;
+        if (i % 3 == 0) p.x = e;
+        else if (i % 3 == 1) p.y = e;
+        else p.z = e;
+        return p;
+    }
+    float o = i % 2 == 0 ? -0.25 : 1.5; // outside [0, 1]: clamped
+    vec3 p = vec3(u64((19 * i + 4) % 64), u64((31 * i + 8) % 64), u64((43 * i + 10) % 64));
+    if (i % 3 == 0) p.x = o;
+    if (i % 5 < 2) p.y = o;
+    if (i % 7 < 3) p.z = o;
+    return p;
+}
+
+float so_bent_case(int i, int c) {
+    vec3 n = dir_of(i), v = dir_of((7 * i + 3) % 64);
+    float ao = c == 3 ? 0.96875 : u64((13 * i + 3) % 64);
+    vec3 b = c == 1 ? n : (c == 2 ? -n : normalize(n + 0.5 * dir_of(63 - i)));
+    return ibl_specular_occlusion_bent(u_so, n, v, b, u64(i), ao);
+}
+
+vec3 probe_texel(int i, int a) { // texel-space position, exact in float
+    float f = float((4099 * i) % 65536) / 65536.0, f2 = float((1237 * i + 77) % 65536) / 65536.0,
+          f3 = float((3011 * i + 5) % 65536) / 65536.0;
+    float p = float(i % 7), q = float((3 * i + 1) % 8), r = float((5 * i + 2) % 8);
+    if (a == 0) return vec3(p + f, q, r);
+    if (a == 1) return vec3(q, p + f, r);
+    if (a == 2) return vec3(q, r, p + f);
+    return vec3(float(i % 7) + f, float((3 * i + 2) % 7) + f2, float((5 * i + 3) % 7) + f3);
+}
+
+vec4 occlusion_row(int j, int i) {
+    if (j == 28) {
+        vec3 p = so_point(i, 0), q = so_point(i, 3);
+        return vec4(ibl_specular_occlusion_coord(p.x, p.y, p.z, 8), ibl_specular_occlusion_coord(q.x, q.y, q.z, 32).x);
+    }
+    if (j == 29) {
+        vec4 o;
+        for (int c = 0; c < 4; ++c) {
+            vec3 p = so_point(i, c);
+            o[c] = ibl_specular_occlusion_table(u_so, p.x, p.y, p.z);
+        }
+        return o;
+    }
+    if (j == 30) return vec4(so_bent_case(i, 0), so_bent_case(i, 1), so_bent_case(i, 2), so_bent_case(i, 3));
+    if (j == 31) { // the sampler alone at exact texel-space positions (its filter weights)
+        vec4 o;
+        for (int a = 0; a < 4; ++a) o[a] = textureLod(u_so, (probe_texel(i, a) + 0.5) / 8.0, 0.0).r;
+        return o;
+    }
+    return vec4(0.0);
+}
+
 vec4 runtime_row(int j, int i) {
+    if (j >= 28) return occlusion_row(j, i);
     float x = u64(i);
     if (j == 18) {
         vec3 g = dir_of(63 - i) * vec3(1.0, -1.0, 1.0);

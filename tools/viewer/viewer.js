@@ -400,8 +400,9 @@ async function runNumericTest() {
     if (!gl) throw new Error('WebGL2 is not available');
     if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to read float results');
     const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('numeric.frag.glsl')));
-    const W = 64, H = 28;
-    // The runtime rows' fixtures (glsl_reference --fixtures): an RGBA32F chain, two RGBA32F tables.
+    const W = 64, H = 32;
+    // The runtime rows' fixtures (glsl_reference --fixtures): an RGBA32F chain, two RGBA32F tables,
+    // an R32F 3-D occlusion table.
     if (!gl.getExtension('OES_texture_float_linear')) throw new Error('OES_texture_float_linear is needed to filter the fixtures');
     const fx = JSON.parse(await fetchText(params.get('bake') + 'numeric_fixtures.json'));
     const chain = gl.createTexture();
@@ -435,7 +436,14 @@ async function runNumericTest() {
     };
     table(1, fx.taps.a);
     table(2, fx.taps.b);
-    gl.activeTexture(gl.TEXTURE3); // the render target below binds here, on no sampler's unit
+    // The occlusion rows' table: size^3 R32F, x = n.v, y = r, z = ao, linear, clamp to edge.
+    gl.activeTexture(gl.TEXTURE3);
+    gl.bindTexture(gl.TEXTURE_3D, gl.createTexture());
+    gl.texImage3D(gl.TEXTURE_3D, 0, gl.R32F, fx.so.size, fx.so.size, fx.so.size, 0, gl.RED, gl.FLOAT, new Float32Array(fx.so.data));
+    gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_MIN_FILTER, gl.LINEAR);
+    gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_MAG_FILTER, gl.LINEAR);
+    for (const w of [gl.TEXTURE_WRAP_S, gl.TEXTURE_WRAP_T, gl.TEXTURE_WRAP_R]) gl.texParameteri(gl.TEXTURE_3D, w, gl.CLAMP_TO_EDGE);
+    gl.activeTexture(gl.TEXTURE4); // the render target below binds here, on no sampler's unit
     const fb = gl.createFramebuffer(), tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_2D, tex);
     gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, W, H, 0, gl.RGBA, gl.FLOAT, null);
@@ -446,6 +454,7 @@ async function runNumericTest() {
     gl.uniform1i(gl.getUniformLocation(program, 'u_chain'), 0);
     gl.uniform1i(gl.getUniformLocation(program, 'u_taps_a'), 1);
     gl.uniform1i(gl.getUniformLocation(program, 'u_taps_b'), 2);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_so'), 3);
     gl.bindVertexArray(gl.createVertexArray());
     gl.drawArrays(gl.TRIANGLES, 0, 3);
     const out = new Float32Array(4 * W * H);
