@@ -154,9 +154,6 @@ cell_sums measure(const Env& env, const ibl::cube_env_distribution& dist, const 
                             d3 n, v;
                             make_point(std::uint32_t(k + 1000 * im), mu, n, v);
                             const ibl::visibility_cone cone = ibl::make_bent_cone(n, v, tilt, to);
-                            const d3 rd = 2.0 * glm::dot(n, v) * n - v;
-                            const double b_r = std::clamp(glm::dot(cone.axis, rd), 0.0, 1.0);
-                            const double b_n = glm::dot(cone.axis, n);
                             for (int m = 0; m < 2; ++m) {
                                 ibl::reference_material rm;
                                 rm.diffuse_albedo = d3(0.0);
@@ -176,8 +173,8 @@ cell_sums measure(const Env& env, const ibl::cube_env_distribution& dist, const 
                                     ao,
                                     double(ibl::specular_occlusion_lagarde(float(mu), float(ao), float(r))),
                                     double(ibl::specular_occlusion_lookup(*prod.so, float(mu), float(r), float(ao))),
-                                    double(ibl::specular_occlusion_lookup(*prod.so, float(b_r), float(r),
-                                                                          float(b_n > 0.0 ? std::min(1.0, ao / b_n) : 1.0))),
+                                    double(ibl::specular_occlusion_bent(prod.so->data.data(), prod.so->size, f3(n), f3(v),
+                                                                        f3(cone.axis), float(r), float(ao))),
                                     ratio};
                                 double* o = &buf[(k * 2 + std::size_t(m)) * k_stride];
                                 for (int q = 0; q < n_var; ++q) {

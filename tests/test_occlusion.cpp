@@ -254,3 +254,23 @@ TEST_CASE("occlusion: the visible fraction of the lobe and its table") {
         CHECK(s < 0.75);
     }
 }
+
+TEST_CASE("specular occlusion: the bent reading is the table at (b.R, r, min(1, ao / b.n))") {
+    const ibl::specular_occlusion_lut lut = ibl::make_specular_occlusion_lut(8, 32, ibl::serial_executor{});
+    const ibl::vec3<float> n(0.0f, 0.0f, 1.0f), v = glm::normalize(ibl::vec3<float>(0.6f, 0.0f, 0.8f));
+    const ibl::vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
+    for (const float ao : {0.25f, 0.5f, 0.9f})
+        for (const float rough : {0.2f, 0.6f}) {
+            // b = n: the plain table at (n.v, r, ao)
+            CHECK(ibl::specular_occlusion_bent(lut.data.data(), lut.size, n, v, n, rough, ao) ==
+                  ibl::specular_occlusion_lookup(lut, glm::dot(n, v), rough, ao));
+            // a bent normal tilted towards R
+            const ibl::vec3<float> b = glm::normalize(ibl::vec3<float>(-0.3f, 0.0f, 1.0f));
+            const float a = std::fmin(1.0f, ao / glm::dot(b, n));
+            CHECK(ibl::specular_occlusion_bent(lut.data.data(), lut.size, n, v, b, rough, ao) ==
+                  ibl::specular_occlusion_lookup(lut, ibl::saturate(glm::dot(b, r_dir)), rough, a));
+            // a cone facing away from n: nothing is read as occluded
+            CHECK(ibl::specular_occlusion_bent(lut.data.data(), lut.size, n, v, -n, rough, ao) ==
+                  ibl::specular_occlusion_lookup(lut, 0.0f, rough, 1.0f));
+        }
+}

@@ -33,6 +33,7 @@
 #include <vector>
 
 #include "core/math.hpp"
+#include "core/vec.hpp"
 
 namespace ibl {
 
@@ -65,6 +66,21 @@ IBL_FUNC T specular_occlusion_table(const float* data, std::uint32_t size, T n_d
         out += w * T(data[idx]);
     }
     return saturate(out);
+}
+
+/// The bent-normal reading (header of docs/occlusion.md: "lobe LUT, bent"): the table at
+/// (saturate(b.R), r, min(1, ao / b.n)) for a visibility cone about the unit bent normal b, R =
+/// reflect(-v, n): the lobe's direction measured from the cone's axis and the cone's own aperture
+/// (ao = cos(beta) sin^2 theta_o inverted without the horizon clip); b.n <= 0 reads ao' = 1.
+/// Equal to the plain table for b = n. GLSL: ibl_specular_occlusion_bent.
+template <class T>
+IBL_FUNC T specular_occlusion_bent(const float* data, std::uint32_t size, const vec3<T>& n, const vec3<T>& v,
+                                   const vec3<T>& bent_normal, T roughness, T ambient_occlusion) noexcept {
+    const vec3<T> r_dir = T(2) * glm::dot(n, v) * n - v;
+    const T b_r = saturate(glm::dot(bent_normal, r_dir));
+    const T b_n = glm::dot(bent_normal, n);
+    const T a = b_n > T(0) ? saturate(ambient_occlusion) / b_n : T(1);
+    return specular_occlusion_table(data, size, b_r, roughness, a < T(1) ? a : T(1));
 }
 
 /// specular_occlusion_table on a host table (host function).

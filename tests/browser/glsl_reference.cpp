@@ -412,15 +412,14 @@ float so_read(float n_dot_v, float r, float ao) {
     return ibl::specular_occlusion_lookup(fixture_so(), n_dot_v, r, ao);
 }
 
-/// The bent-normal reading (docs/occlusion.md "lobe LUT, bent", examples/occlusion_error.cpp) in
-/// float: so(saturate(b.R), r, b.n > 0 ? min(1, ao / b.n) : 1), R = 2 (n.v) n - v. Also returns its
-/// table inputs.
+/// The bent-normal reading (ibl::specular_occlusion_bent, in float): so(saturate(b.R), r,
+/// b.n > 0 ? min(1, ao / b.n) : 1), R = 2 (n.v) n - v. Also returns its table inputs.
 float so_bent(const v3& n, const v3& v, const v3& b, float r, float ao, v3* at = nullptr) {
     const v3 rd = 2.0f * glm::dot(n, v) * n - v;
     const float b_r = ibl::saturate(glm::dot(b, rd)), b_n = glm::dot(b, n);
     const float a = b_n > 0.0f ? std::fmin(1.0f, ao / b_n) : 1.0f;
     if (at) *at = v3(b_r, r, a);
-    return so_read(b_r, r, a);
+    return ibl::specular_occlusion_bent(fixture_so().data.data(), fixture_so().size, n, v, b, r, ao);
 }
 
 /// The bent row's column c of case i: n = dir_of(i), v = dir_of((7 i + 3) mod 64), r = i / 64;
