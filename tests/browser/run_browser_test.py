@@ -6,7 +6,7 @@ SwiftShader's WebGL2), compared with the C++.
            repository's tools/viewer/ and include/ibl/glsl/ and the folder on 127.0.0.1, lets
            tools/viewer/index.html?test=preview render ibl-bake's preview grid from specular.ktx2,
            dfg.hpp, lobe_lut.hpp (the default runtime model; --preset filament / gltf bake the
-           split sum), sh.json and report.json, and compares its pixels with the bake's own
+           split sum; --runtime taps2 the two-tap table, lobe_taps.hpp), sh.json and report.json, and compares its pixels with the bake's own
            preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
            interactive viewer to --out (docs/shaders-viewer.png).
@@ -300,6 +300,12 @@ def compare_preview(bake_dir, result):
         raise RuntimeError(f"the page shaded with {info.get('runtime_model')!r}, the bake's model is {expected_model!r}")
     if expected_model == "lobe" and info.get("lobe_texture") != "RGBA32F":
         raise RuntimeError("the lobe LUT is not an RGBA32F texture: no bound derived")
+    # The two-tap model (runtime_model "taps2"): lobe_taps.hpp's exact floats in two RGBA32F
+    # textures; the taps' directions cos(a) n + sin(a) t are formed in float on both sides and LD
+    # is their weighted mean, a convex combination of chain reads that keeps the chain's relative
+    # bound: inside the terms below.
+    if expected_model == "taps2" and info.get("taps_texture") != "RGBA32F":
+        raise RuntimeError("the two-tap table is not an RGBA32F texture: no bound derived")
     eps = max(chain_eps[f] for f in formats) + 1e-5
     # The sun (lights.json) as a disk light: its specular D(n.h; alpha') turns an error dc of n.h
     # into a relative error <= 4 dc / alpha'^2 (at the lobe's peak, c = 1), alpha'^2 >= tan^2(r/2)
@@ -344,7 +350,8 @@ def compare_preview(bake_dir, result):
     print(f"chain {info['chain_format']} levels {info['chain_levels']}, DFG texture {info['lut_texture']} "
           f"{info['lut_size']}^2, exposure {info['exposure']:.8g}, {ss}x{ss} samples per pixel")
     print(f"runtime model {info['runtime_model']}" +
-          (f" (lobe LUT {info['lobe_texture']} {info['lobe_size']}^2)" if info['runtime_model'] == "lobe" else ""))
+          (f" (lobe LUT {info['lobe_texture']} {info['lobe_size']}^2)" if info['runtime_model'] == "lobe" else "") +
+          (f" (two-tap table 2 x {info['taps_texture']} {info['taps_size']}^2)" if info['runtime_model'] == "taps2" else ""))
     print(f"sun: " + (f"omega {info['sun']['solidAngle']:.6g} sr, specular term's eps {sun_eps:.3g}" if info.get("sun") else "none"))
     print(f"derived: eps = {eps:.3g} relative, max 8-bit slope {slope:.2f} per unit ln L, delta {delta:.3f} "
           f"-> bound {bound} (8-bit units)")

@@ -140,7 +140,7 @@ const std::map<std::string, option_spec>& option_table() {
              o.specular_lookup = choice("--specular-lookup", v, {"default", "textbook"});
          }}},
         {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {"g1", "nl"}); }}},
-        {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {"lobe", "split-sum"}); }}},
+        {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {"lobe", "taps2", "split-sum"}); }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
@@ -251,9 +251,10 @@ std::string usage_text() {
            "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
            "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
            "  --ld-weight W      g1 (default: D G1, the true lobe at n.v = 1) | nl (Karis D n.l): the chain's weight\n"
-           "  --runtime M        lobe (default: LD(lerp(n, R, s), r_eff) from the lobe LUT) | split-sum (LD(R, r) DFG)\n"
+           "  --runtime M        lobe (default: LD(lerp(n, R, s), r_eff) from the lobe LUT) | taps2 (two fitted taps,\n"
+           "                     lobe_taps_{a,b}.exr) | split-sum (LD(R, r) DFG)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
-           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R\n"
+           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R, taps NV R\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --help, --version\n";

@@ -33,7 +33,8 @@
 //   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
 //   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
 //   --ld-weight W       g1 (default: D G1, the lobe at n.v = 1) | nl (Karis's D n.l): the chain's weight
-//   --runtime M         lobe (default: the lobe LUT, lobe_lut.exr) | split-sum (LD(R, r) DFG)
+//   --runtime M         lobe (default: the lobe LUT, lobe_lut.exr) | taps2 (the fitted two-tap model,
+//                       lobe_taps_a.exr, lobe_taps_b.exr) | split-sum (LD(R, r) DFG)
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
@@ -85,7 +86,7 @@ struct bake_options {
     std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
     std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
     std::string ld_weight = "g1";              ///< the chain's LD weight: g1 | nl (ibl::ld_weight)
-    std::string runtime = "lobe";              ///< the runtime model: lobe (lobe LUT) | split-sum
+    std::string runtime = "lobe";              ///< the runtime model: lobe (lobe LUT) | taps2 (two-tap table) | split-sum
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)

@@ -153,7 +153,14 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         const ibl::vec4<double> p = v.lobe_params(unit_interval(a[0]), unit_interval(a[1]));
         return fmt9(p.x) + " " + fmt9(p.y) + " " + fmt9(p.z) + " " + fmt9(p.w);
     }
-    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe)");
+    if (word == "taps") {
+        need(2);
+        if (!b.has_taps) throw std::invalid_argument("the bake has no two-tap table (bake with --runtime taps2)");
+        std::string s;
+        for (const float x : v.taps_params(unit_interval(a[0]), unit_interval(a[1]))) s += (s.empty() ? "" : " ") + fmt9(x);
+        return s;
+    }
+    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe, taps)");
 }
 
 } // namespace
@@ -170,15 +177,40 @@ product_view baked_folder::view() const {
     v.dfg_layout = dfg_layout;
     v.sun = sun ? &*sun : nullptr;
     v.lobe = has_lobe ? &lobe : nullptr;
+    v.taps = has_taps ? &taps : nullptr;
     v.weight = weight;
     return v;
 }
 
 namespace {
+/// The two-tap table from its GLSL storage split: channels 0..3 from lobe_taps_a.exr, 4..7 from
+/// lobe_taps_b.exr.
+void load_taps(baked_folder& b, const std::string& dir) {
+    const image_rgba32f ta = read_exr_rgba(dir + "/lobe_taps_a.exr"), tb = read_exr_rgba(dir + "/lobe_taps_b.exr");
+    if (ta.width != ta.height) throw std::runtime_error(dir + "/lobe_taps_a.exr: the two-tap table is not square");
+    if (tb.width != ta.width || tb.height != ta.height)
+        throw std::runtime_error(dir + "/lobe_taps_b.exr: not the size of lobe_taps_a.exr");
+    b.taps.size = std::uint32_t(ta.width);
+    b.taps.taps = 2;
+    b.taps.channels = 8;
+    b.taps.weight = b.weight;
+    b.taps.data.resize(std::size_t(b.taps.size) * b.taps.size * 8);
+    for (std::size_t k = 0; k < std::size_t(b.taps.size) * b.taps.size; ++k)
+        for (std::size_t c = 0; c < 4; ++c) {
+            b.taps.data[k * 8 + c] = ta.rgba[k * 4 + c];
+            b.taps.data[k * 8 + 4 + c] = tb.rgba[k * 4 + c];
+        }
+    b.has_taps = true;
+}
+
 /// The runtime model of plan.runtime (bakes before it: the split sum of an n.l chain).
 void load_runtime_model(baked_folder& b, const json_value& rt, const std::string& dir) {
     if (const json_value* w = rt.find("ld_weight"); w && w->find("name")) b.weight = ld_weight_named(w->find("name")->string);
     const json_value* m = rt.find("runtime_model");
+    if (m && m->find("name") && m->find("name")->string == "taps2") {
+        load_taps(b, dir);
+        return;
+    }
     if (!m || !m->find("name") || m->find("name")->string != "lobe") return;
     const image_rgba32f img = read_exr_rgba(dir + "/lobe_lut.exr");
     if (img.width != img.height) throw std::runtime_error(dir + "/lobe_lut.exr: the lobe LUT is not square");

@@ -26,6 +26,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     s.push_back(make_irradiance_stage());
     s.push_back(make_dfg_stage());
     s.push_back(make_lobe_lut_stage());
+    s.push_back(make_lobe_taps_stage());
     s.push_back(make_sheen_stage());
     s.push_back(make_lookup_stage());
     s.push_back(make_split_sum_stage());

@@ -28,6 +28,7 @@
 #include <ibl/env/cubemap.hpp>
 #include <ibl/env/latlong.hpp>
 #include <ibl/integrate/dfg_lut.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/plan.hpp>
 #include <ibl/sh/basis.hpp>
@@ -126,6 +127,7 @@ struct bake_context {
     std::optional<ibl::cubemap<float>> chain; ///< the stored levels of plan.specular
     std::optional<ibl::dfg_lut> lut;
     std::optional<ibl::lobe_lut> lobe; ///< the lobe LUT (--runtime lobe)
+    std::optional<ibl::lobe_taps_lut> taps; ///< the two-tap table (--runtime taps2)
     diffuse_data diffuse;
     product_times measured; ///< filled by the pipeline after each product stage
 };

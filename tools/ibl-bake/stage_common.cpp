@@ -4,7 +4,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <locale>
 #include <span>
+#include <sstream>
 
 #include <ibl/core/color.hpp>
 #include <ibl/env/convert.hpp>
@@ -75,11 +77,45 @@ ibl::vec4<double> product_view::lobe_params(double n_dot_v, double roughness) co
     return ibl::vec4<double>(ibl::lobe_lut_lookup(*lobe, float(n_dot_v), float(roughness), dfg_layout));
 }
 
+std::array<float, 8> product_view::taps_params(double n_dot_v, double roughness) const {
+    const ibl::vec2<float> st = ibl::dfg_lut_coord(float(n_dot_v), float(roughness), taps->size, dfg_layout);
+    std::array<float, 8> p{};
+    ibl::detail::table_bilinear(*taps, st.x, st.y, p.data(), std::uint32_t(p.size()));
+    return p;
+}
+
+namespace {
+/// LD of the two-tap model, as ibl::specular_lobe_taps forms it: the taps' directions in float
+/// (cos(a) n + sin(a) t, t = incidence_tangent(n, R)), each read by the view's chain lookup, the
+/// weighted mean; LD(R, r) where no weight is > 0.
+dvec3 taps_ld(const product_view& pv, const std::array<float, 8>& p, const dvec3& n, const dvec3& v, double roughness) {
+    const fvec3 fn(n), fv(v);
+    const fvec3 r_dir = 2.0f * glm::dot(fn, fv) * fn - fv;
+    const fvec3 t = ibl::incidence_tangent(fn, r_dir);
+    dvec3 sum(0.0);
+    double wsum = 0.0;
+    for (int k = 0; k < 2; ++k) {
+        const float a = p[std::size_t(2 + 3 * k)] * ibl::half_pi_v<float>, w = p[std::size_t(4 + 3 * k)];
+        if (!(w > 0.0f)) continue;
+        const fvec3 d = glm::normalize(std::cos(a) * fn + std::sin(a) * t);
+        sum += double(w) * pv.ld(dvec3(d), p[std::size_t(3 + 3 * k)]);
+        wsum += double(w);
+    }
+    return wsum > 0.0 ? sum / wsum : pv.ld(dvec3(r_dir), roughness);
+}
+} // namespace
+
 ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
     const double n_dot_v = std::clamp(glm::dot(n, v), 0.0, 1.0);
     const dvec3 r_dir = 2.0 * glm::dot(n, v) * n - v;
     ibl::ibl_sample<double> s;
     if (diffuse) s.irradiance_over_pi = diffuse->irradiance_over_pi(n);
+    if (taps) {
+        const std::array<float, 8> p = taps_params(n_dot_v, roughness);
+        s.ld = taps_ld(*this, p, n, v, roughness);
+        s.dfg = ibl::vec2<double>(p[0], p[1]);
+        return s;
+    }
     if (lobe) { // as ibl::specular_lobe: the direction in float, the chain at r_eff
         const ibl::vec4<double> p = lobe_params(n_dot_v, roughness);
         s.ld = ld(dvec3(ibl::lerp_direction(fvec3(n), fvec3(r_dir), float(p.z))), p.w);
@@ -111,8 +147,8 @@ int lobe_lut_size_for(int dfg_size) { return std::clamp(dfg_size, 1, 24); }
 runtime_model runtime_model_of(const bake_options& o, const ibl::bake_plan& plan) {
     runtime_model m;
     m.ld_weight = o.ld_weight;
-    if (o.runtime == "lobe" && plan.dfg.enabled && plan.dfg.size > 0 && plan.specular.enabled) {
-        m.name = "lobe";
+    if ((o.runtime == "lobe" || o.runtime == "taps2") && plan.dfg.enabled && plan.dfg.size > 0 && plan.specular.enabled) {
+        m.name = o.runtime;
         m.lobe_lut_size = lobe_lut_size_for(plan.dfg.size);
     }
     return m;
@@ -138,6 +174,13 @@ void json_runtime_model(json_writer& j, const runtime_model& rm) {
         j.key("channels").value("R = A, G = B, B = s, A = r_eff");
         j.key("rule").value("(A, B, s, r_eff) = lobe LUT at (n.v, r) in the DFG layout (bilinear); specular = "
                             "LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) (ibl::specular_lobe)");
+    } else if (rm.name == "taps2") {
+        j.key("lut").value("lobe_taps_a.exr, lobe_taps_b.exr (lobe_taps.hpp)").key("lut_size").value(rm.lobe_lut_size);
+        j.key("channels").value("lobe_taps_a: R = A, G = B, B = angle0 / (pi/2), A = roughness0; lobe_taps_b: R = weight0, "
+                                "G = angle1 / (pi/2), B = roughness1, A = weight1");
+        j.key("rule").value("the 8 channels = the two tables at (n.v, r) in the DFG layout (bilinear); t = the tangent of n "
+                            "towards R; specular = (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k) / sum_k w_k "
+                            "(ibl::specular_lobe_taps; LD(R, r) where no weight is > 0)");
     } else {
         j.key("rule").value("specular = LD(R, r) (F0 A + F90 B), (A, B) from the DFG table");
     }
@@ -179,8 +222,23 @@ product_view baked_view(const bake_context& ctx) {
     v.diffuse = &ctx.diffuse;
     v.sun = ctx.sun ? &*ctx.sun : nullptr;
     v.lobe = ctx.lobe ? &*ctx.lobe : nullptr;
+    v.taps = ctx.taps ? &*ctx.taps : nullptr;
     v.weight = ld_weight_named(ctx.opt.ld_weight);
     return v;
+}
+
+std::string c_float_list(const std::vector<float>& v) {
+    std::ostringstream os;
+    for (std::size_t k = 0; k < v.size(); ++k) {
+        std::ostringstream num;
+        num.imbue(std::locale::classic());
+        num.precision(9);
+        num << v[k];
+        std::string s = num.str();
+        if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
+        os << (k % 32 == 0 ? "    " : " ") << s << "f" << (k + 1 < v.size() ? "," : "") << (k % 32 == 31 || k + 1 == v.size() ? "\n" : "");
+    }
+    return os.str();
 }
 
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level) {

@@ -44,15 +44,7 @@ std::string lobe_lut_header(const ibl::lobe_lut& t, const std::string& weight, c
        << ";\n// row 0 (smallest roughness) first: value = lobe_lut[(j * size + i) * 4 + c].\n\nnamespace ibl_baked {\n\n"
        << "inline constexpr unsigned lobe_lut_size = " << t.size << ";\ninline constexpr unsigned lobe_lut_channels = 4;\n"
        << "inline constexpr float lobe_lut[" << t.data.size() << "] = {\n";
-    for (std::size_t k = 0; k < t.data.size(); ++k) {
-        std::ostringstream num;
-        num.imbue(std::locale::classic());
-        num.precision(9);
-        num << t.data[k];
-        std::string s = num.str();
-        if (s.find_first_of(".eEn") == std::string::npos) s += ".0";
-        os << (k % 32 == 0 ? "    " : " ") << s << "f" << (k + 1 < t.data.size() ? "," : "") << (k % 32 == 31 || k + 1 == t.data.size() ? "\n" : "");
-    }
+    os << c_float_list(t.data);
     os << "};\n\n} // namespace ibl_baked\n";
     return os.str();
 }

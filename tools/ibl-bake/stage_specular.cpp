@@ -29,7 +29,8 @@ constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 refere
 
 /// What a loader needs, in the KTX2's key/value data: the level -> roughness mapping, the first
 /// stored level of the virtual chain, the policy, the lookup, the preset, the chain's LD weight
-/// and the runtime model (lobe: read with lobe_lut.exr; split-sum: with dfg.exr).
+/// and the runtime model (lobe: read with lobe_lut.exr; taps2: with lobe_taps_a.exr and
+/// lobe_taps_b.exr; split-sum: with dfg.exr).
 std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_context& ctx) {
     const ibl::specular_plan& sp = ctx.plan.specular;
     std::string r;

@@ -1,12 +1,13 @@
 // tools/ibl-bake/stage_split_sum.cpp — check: what the baked products give through the runtime
 // model. The single-scattering ambient of shade.hpp from the baked products (the chain read by
 // ibl/lookup.hpp's lookups; with --runtime lobe at the lobe LUT's direction and roughness with its
-// (A, B), else at R and r with the DFG table's) and the diffuse product, plus an extracted sun as a
+// (A, B), with --runtime taps2 at the two taps' directions and roughness with the table's (A, B),
+// else at R and r with the DFG table's) and the diffuse product, plus an extracted sun as a
 // disk light, against ibl::reference_radiance (MIS of the BRDF and the source's luminance
 // distribution, no split sum) with the same diffuse weighting, for a dielectric and a metal at
-// three roughness values, seen in three views about the brightest direction. With the lobe model
-// the plain split sum (LD(R, r) DFG) of the same products is measured too, against the same
-// reference: the report shows both.
+// three roughness values, seen in three views about the brightest direction. With the lobe or
+// taps2 model the plain split sum (LD(R, r) DFG) of the same products is measured too, against
+// the same reference: the report shows both.
 
 #include "stages.hpp"
 
@@ -87,7 +88,7 @@ public:
         const std::vector<view_geom> views = make_views(ctx.light);
         nviews_ = views.size();
         const product_view bp = baked_view(ctx);
-        lobe_ = bp.lobe != nullptr;
+        model_ = bp.taps ? "taps2" : bp.lobe ? "lobe" : "split-sum";
         for (const material_case& mc : k_materials)
             for (const double r : k_roughness) {
                 ctx.prog.label(std::string(mc.name) + fmt(" r=%.1f", r));
@@ -107,7 +108,7 @@ private:
 
     std::uint32_t samples_ = 0;
     std::size_t nviews_ = 0;
-    bool lobe_ = false;
+    std::string model_ = "split-sum"; ///< the runtime model measured beside the plain split sum
     std::vector<split_result> results_;
 };
 
@@ -136,7 +137,7 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
             return view_result{g.name, g.n_dot_v, yr, ys, yr > 0.0 ? ys / yr - 1.0 : 0.0, se};
         };
         res.runtime.add(result(bp), views.size());
-        res.plain.add(bp.lobe ? result(bp.split_sum()) : res.runtime.views.back(), views.size());
+        res.plain.add(bp.lobe || bp.taps ? result(bp.split_sum()) : res.runtime.views.back(), views.size());
     }
     res.ms = ms_since(t0);
     return res;
@@ -144,18 +145,20 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
 
 std::vector<table_row> split_sum_stage::rows() const {
     std::vector<table_row> rows;
-    auto row = [&](const split_result& res, const model_result& m, bool lobe) {
+    auto row = [&](const split_result& res, const model_result& m, const std::string& model) {
         double se = 0.0;
         for (const auto& v : m.views) se = std::max(se, v.se_rel);
-        rows.push_back({std::string(lobe ? "lobe lut " : "split sum ") + res.material + fmt(" r=%.1f", res.roughness),
-                        lobe ? "baked LD(lerp(n,R,s), r_eff)+lobe LUT+SH vs MIS" : "baked LD+DFG+SH vs MIS reference",
-                        std::to_string(nviews_) + " views x " + std::to_string(samples_) + " spp", lobe ? -1.0 : res.ms,
+        const bool plain = model == "split-sum";
+        rows.push_back({std::string(plain ? "split sum " : model == "lobe" ? "lobe lut " : "taps2 ") + res.material + fmt(" r=%.1f", res.roughness),
+                        plain ? "baked LD+DFG+SH vs MIS reference"
+                              : model == "lobe" ? "baked LD(lerp(n,R,s), r_eff)+lobe LUT+SH vs MIS" : "baked 2 x LD(d_k, r_k)+taps LUT+SH vs MIS",
+                        std::to_string(nviews_) + " views x " + std::to_string(samples_) + " spp", plain ? res.ms : -1.0,
                         fmt2("mean |rel| %.2f%%, max |rel| %.2f%%", 100.0 * m.mean_abs_rel, 100.0 * m.max_abs_rel) +
                             fmt(" (ref se %.2f%%)", 100.0 * se)});
     };
-    for (const auto& res : results_) row(res, res.plain, false);
-    if (lobe_)
-        for (const auto& res : results_) row(res, res.runtime, true);
+    for (const auto& res : results_) row(res, res.plain, "split-sum");
+    if (model_ != "split-sum")
+        for (const auto& res : results_) row(res, res.runtime, model_);
     return rows;
 }
 
@@ -163,11 +166,13 @@ void split_sum_stage::report(json_writer& j) const {
     j.begin_object();
     j.key("method").value("single-scattering ambient (shade.hpp) from the baked products through the runtime model "
                           "(runtime_model; lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B, s, r_eff) from the lobe "
-                          "LUT; split-sum: LD at R and r, (A, B) from the DFG LUT), the chain by the bake's lookup, the "
+                          "LUT; taps2: sum_k w_k LD(d_k, r_k) / sum_k w_k at the two taps' directions and roughness, "
+                          "(A, B) and the taps from the two-tap table; split-sum: LD at R and r, (A, B) from the DFG "
+                          "LUT), the chain by the bake's lookup, the "
                           "diffuse product; against ibl::reference_radiance (MIS of the BRDF and the source's luminance "
                           "distribution), same diffuse weighting. materials: the runtime model; materials_split_sum: "
                           "the plain split sum of the same products");
-    j.key("runtime_model").value(lobe_ ? "lobe" : "split-sum");
+    j.key("runtime_model").value(model_);
     j.key("samples_per_view").value(samples_);
     report_model(j, true);
     report_model(j, false);

@@ -11,12 +11,15 @@
 //   sheen         (--sheen) the Charlie sheen chain and the sheen albedo LUT
 //   dfg           the split-sum DFG table by exact quadrature
 //   lobe_lut      (--runtime lobe) the lobe LUT (A, B, s, r_eff) in the DFG table's layout
+//   lobe_taps     (--runtime taps2) the fitted two-tap table (A, B, 2 x (angle, roughness,
+//                 weight)) in the DFG table's layout
 //   lookup        check: the chain where a renderer samples it (between levels), vs exact LD
 //   split_sum     check: the baked products through the runtime model (and the plain split
 //                 sum) against the full integral
 //   preview       check: a sphere grid rendered from the baked products
 //   compare_full  check (--scene --compare-full): full and converged bakes, the plan's error
 
+#include <array>
 #include <chrono>
 #include <memory>
 #include <string>
@@ -41,6 +44,7 @@ std::unique_ptr<stage> make_sh_stage();
 std::unique_ptr<stage> make_irradiance_stage();
 std::unique_ptr<stage> make_dfg_stage();
 std::unique_ptr<stage> make_lobe_lut_stage();
+std::unique_ptr<stage> make_lobe_taps_stage();
 std::unique_ptr<stage> make_sheen_stage();
 std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
@@ -63,9 +67,12 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
 /// The products as a renderer samples them (ibl/lookup.hpp): the chain by the lookup `specular`
 /// (its taps over the virtual chain, minus the first stored level, clamped to the stored levels),
 /// the DFG table by ibl::dfg_lookup in its layout (or dfg_exact when there is none), the diffuse
-/// product. The runtime model is the lobe LUT's when `lobe` is set (ibl/runtime.hpp,
-/// specular_lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B) from the lobe LUT, both read in
-/// the DFG table's layout), else the plain split sum (LD at R and r, (A, B) from the DFG table).
+/// product. The runtime model is the two-tap model when `taps` is set (ibl/runtime.hpp,
+/// specular_lobe_taps: LD = sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k) / sum_k w_k, t the tangent
+/// of n towards R, (A, B) and the taps from one bilinear read of the table), the lobe LUT's when
+/// `lobe` is set (specular_lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B) from the lobe
+/// LUT), both tables read in the DFG table's layout, else the plain split sum (LD at R and r,
+/// (A, B) from the DFG table).
 struct product_view {
     const ibl::cubemap<float>* chain = nullptr;
     ibl::roughness_mip_policy policy{};
@@ -76,6 +83,7 @@ struct product_view {
     ibl::dfg_lut_layout dfg_layout{};
     const ibl::disk_light<double>* sun = nullptr; ///< an extracted sun, added by the shading functions
     const ibl::lobe_lut* lobe = nullptr;          ///< the lobe LUT: the runtime model is lobe when set
+    const ibl::lobe_taps_lut* taps = nullptr;     ///< the two-tap table: the runtime model is taps2 when set
     ibl::ld_weight weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight (of the sun's LD term)
 
     /// LD at reflection direction r_dir and roughness (the chain only).
@@ -84,10 +92,14 @@ struct product_view {
     ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
     /// The lobe LUT's (A, B, s, r_eff) at (n.v, r) (ibl::lobe_lut_lookup); needs `lobe`.
     ibl::vec4<double> lobe_params(double n_dot_v, double roughness) const;
+    /// The two-tap table's 8 channels at (n.v, r) (one bilinear read in the DFG layout, as
+    /// ibl::specular_lobe_taps reads it); needs `taps`.
+    std::array<float, 8> taps_params(double n_dot_v, double roughness) const;
     /// The same view with the plain split sum as its runtime model.
     product_view split_sum() const {
         product_view p = *this;
         p.lobe = nullptr;
+        p.taps = nullptr;
         return p;
     }
     /// The runtime model: shader's ambient from the products plus the sun as a disk light.
@@ -102,15 +114,17 @@ ibl::dfg_lut_layout dfg_layout_named(const std::string& name);
 ibl::specular_lookup_desc specular_lookup_named(const std::string& name);
 ibl::ld_weight ld_weight_named(const std::string& name);
 
-/// The runtime model of a bake: "lobe" (with its LUT's size) or "split-sum".
+/// The runtime model of a bake: "lobe" or "taps2" (with its table's size) or "split-sum".
 struct runtime_model {
     std::string name = "split-sum";
-    int lobe_lut_size = 0;
+    int lobe_lut_size = 0; ///< texels per side of the lobe LUT or of the two-tap table
     std::string ld_weight = "nl"; ///< the chain's weight: g1 | nl
 };
-/// What the options and the plan give: lobe when --runtime lobe and the plan has a DFG table.
+/// What the options and the plan give: lobe (taps2) when --runtime lobe (taps2) and the plan has
+/// a DFG table and a chain.
 runtime_model runtime_model_of(const bake_options& o, const ibl::bake_plan& plan);
-/// Texels per side of the lobe LUT: 24, at most the DFG table's (docs/ibl-bake.md, "Lobe LUT").
+/// Texels per side of the lobe LUT and of the two-tap table: 24, at most the DFG table's
+/// (docs/ibl-bake.md, "Lobe LUT").
 int lobe_lut_size_for(int dfg_size);
 
 /// Their description in report.json.
@@ -166,6 +180,10 @@ ktx2_format ktx2_format_named(const std::string& name);
 /// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.
 void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
+
+/// The floats of a generated C header's table: 32 per line, 9 significant digits, each with a
+/// decimal point or exponent and the f suffix, comma separated (the body between { and }).
+std::string c_float_list(const std::vector<float>& v);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
 void json_triples(json_writer& j, const sh5& c, int count);

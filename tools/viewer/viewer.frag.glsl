@@ -3,8 +3,8 @@
 //   u_mode 0  ibl-bake's preview.png, mirrored exactly (tools/ibl-bake/stage_preview.cpp): a 5 x 2
 //             grid of 128-pixel cells, orthographic spheres of radius 0.45 cell, roughness 0.25 i
 //             (column i), dielectric base 0.8 on top, metal (0.95, 0.64, 0.54) below,
-//             multiple-scattering ambient (the bake's runtime model: the lobe LUT or the split
-//             sum) plus the bake's sun (lights.json) as a disk light;
+//             multiple-scattering ambient (the bake's runtime model: the lobe LUT, the two-tap
+//             table or the split sum) plus the bake's sun (lights.json) as a disk light;
 //             background = level 0 (the residual) plus the sun's disk, through a 90-degree pinhole;
 //             u_ss x u_ss sub-pixel samples averaged in linear radiance; exposure, Reinhard, sRGB.
 //   u_mode 1  the interactive view: two spheres (dielectric, metal) of one roughness seen through
@@ -14,7 +14,9 @@ uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
 uniform sampler2D u_lut;
 uniform sampler2D u_lobe;  // the lobe LUT (A, B, s, r_eff) in the DFG layout (u_runtime 1)
-uniform int u_runtime;     // 0 split sum (LD(R, r), DFG), 1 the lobe model (report.json runtime_model)
+uniform sampler2D u_taps_a; // the two-tap table, channels 0..3 (A, B, angle0, roughness0) (u_runtime 2)
+uniform sampler2D u_taps_b; // channels 4..7 (weight0, angle1, roughness1, weight1)
+uniform int u_runtime;     // 0 split sum (LD(R, r), DFG), 1 the lobe model, 2 taps2 (report.json runtime_model)
 uniform vec3 u_sh[9];
 uniform int u_diffuse;     // 0 none, 1 SH, 2 irradiance map
 uniform ivec4 u_spec_levels; // virtual_levels, first_level, stored_levels, mapping
@@ -52,10 +54,35 @@ vec3 diffuse_over_pi(vec3 n) {
     return vec3(0.0);
 }
 
+// The two-tap model's sample: ibl_specular_lobe_taps2's LD (its taps, their weighted mean; LD(R, r)
+// where no weight is > 0) and its (A, B), for ibl_ambient to apply the albedo (as ibl-bake's
+// product_view::sample does).
+ibl_sample taps2_sample(vec3 n, vec3 v, float roughness, vec3 irradiance_over_pi) {
+    ibl_specular_desc sd = spec_desc();
+    vec3 r_dir = 2.0 * dot(n, v) * n - v;
+    vec2 st = ibl_dfg_lut_coord(ibl_saturate(dot(n, v)), roughness, textureSize(u_taps_a, 0).x, dfg_layout());
+    vec4 pa = textureLod(u_taps_a, st, 0.0);
+    vec4 pb = textureLod(u_taps_b, st, 0.0);
+    vec3 t = ibl_incidence_tangent(n, r_dir);
+    vec3 sum = vec3(0.0);
+    float wsum = 0.0;
+    if (pb.x > 0.0) {
+        sum += pb.x * ibl_specular_lookup(u_chain, ibl_lobe_tap_direction(n, t, pa.z), pa.w, sd);
+        wsum += pb.x;
+    }
+    if (pb.w > 0.0) {
+        sum += pb.w * ibl_specular_lookup(u_chain, ibl_lobe_tap_direction(n, t, pb.y), pb.z, sd);
+        wsum += pb.w;
+    }
+    vec3 ld = wsum > 0.0 ? sum / wsum : ibl_specular_lookup(u_chain, r_dir, roughness, sd);
+    return ibl_sample(ld, irradiance_over_pi, pa.xy);
+}
+
 vec3 shade_sphere(vec3 n, vec3 v, ibl_material mat) {
     ibl_material_terms m = ibl_resolve_material(mat);
     ibl_sample s; // (WebGL forbids ?: on structures)
-    if (u_runtime == 1) s = ibl_lobe_sample(u_chain, spec_desc(), u_lobe, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
+    if (u_runtime == 2) s = taps2_sample(n, v, m.roughness, diffuse_over_pi(n));
+    else if (u_runtime == 1) s = ibl_lobe_sample(u_chain, spec_desc(), u_lobe, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     else s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     vec3 c = ibl_ambient(m, clamp(dot(n, v), 0.0, 1.0), s, u_spec_rule.z != 0);
     if (u_sun_on != 0) c += ibl_shade_disk(n, v, ibl_disk_light(u_sun_dir, u_sun_solid_angle, u_sun_radiance), m);

@@ -16,7 +16,10 @@
 // irradiance.ktx2 (texels hold E; used when plan.runtime.diffuse is "irradiance_map"), lights.json
 // (optional: an extracted sun, added back as a disk light; the chain and the diffuse product hold the
 // environment without it), lobe_lut.hpp (when plan.runtime.runtime_model.name is "lobe": the lobe
-// LUT, and the spheres are shaded by the lobe model, ibl_lobe_sample; else by the split sum).
+// LUT, and the spheres are shaded by the lobe model, ibl_lobe_sample), lobe_taps.hpp (when it is
+// "taps2": the two-tap table, uploaded as the two RGBA textures of ibl_common.glsl's storage split,
+// and the spheres are shaded by the two-tap model, ibl_specular_lobe_taps2's LD); else by the split
+// sum.
 
 import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
 
@@ -73,11 +76,18 @@ export function parseDfgHeader(text, name = 'dfg_lut') {
     return { size, channels, values: Float32Array.from(values) };
 }
 
-/// The runtime model named by report.json (plan.runtime.runtime_model.name): 'lobe' or 'split-sum'
-/// (bakes without the entry: the split sum).
+/// The runtime model named by report.json (plan.runtime.runtime_model.name): 'lobe', 'taps2' or
+/// 'split-sum' (bakes without the entry: the split sum).
 function runtimeModelOf(report) {
     const m = report && report.plan && report.plan.runtime && report.plan.runtime.runtime_model;
-    return m && m.name === 'lobe' ? 'lobe' : 'split-sum';
+    return m && (m.name === 'lobe' || m.name === 'taps2') ? m.name : 'split-sum';
+}
+
+/// Channels [first, first + 4) of a table of lobe_taps.hpp: one texture of the GLSL storage split.
+function tapsHalf(taps, first) {
+    const n = taps.size * taps.size, values = new Float32Array(4 * n);
+    for (let i = 0; i < n; ++i) for (let k = 0; k < 4; ++k) values[4 * i + k] = taps.values[taps.channels * i + first + k];
+    return { size: taps.size, channels: 4, values };
 }
 
 async function loadBake(src) {
@@ -87,6 +97,8 @@ async function loadBake(src) {
     bake.dfg = parseDfgHeader(await src.text('dfg.hpp'));
     bake.model = runtimeModelOf(bake.report);
     bake.lobe = bake.model === 'lobe' ? parseDfgHeader(await src.text('lobe_lut.hpp'), 'lobe_lut') : null;
+    bake.taps = bake.model === 'taps2' ? parseDfgHeader(await src.text('lobe_taps.hpp'), 'lobe_taps') : null;
+    if (bake.taps && bake.taps.channels !== 8) throw new Error(`lobe_taps.hpp: ${bake.taps.channels} channels, expected 8 (two taps)`);
     bake.chain = parseKtx2Cubemap(await src.bytes('specular.ktx2'), 'specular.ktx2');
     bake.irradiance = (await src.has('irradiance.ktx2')) ? parseKtx2Cubemap(await src.bytes('irradiance.ktx2'), 'irradiance.ktx2') : null;
     bake.sun = (await src.has('lights.json')) ? sunOf(JSON.parse(await src.text('lights.json'))) : null;
@@ -246,6 +258,12 @@ class Renderer {
         const lobe = bake.lobe ? uploadLut(gl, bake.lobe, null) : null; // (A, B, s, r_eff): four channels as stored
         this.lobeTex = lobe ? lobe.tex : this.lutTex;
         this.lobeFormat = lobe ? lobe.format : null;
+        // the two-tap table: taps_a = channels 0..3, taps_b = channels 4..7 (ibl_common.glsl)
+        const tapsA = bake.taps ? uploadLut(gl, tapsHalf(bake.taps, 0), null) : null;
+        const tapsB = bake.taps ? uploadLut(gl, tapsHalf(bake.taps, 4), null) : null;
+        this.tapsATex = tapsA ? tapsA.tex : this.lutTex;
+        this.tapsBTex = tapsB ? tapsB.tex : this.lutTex;
+        this.tapsFormat = tapsA ? tapsA.format : null;
         // The renderer's coefficients: the windowed ones when sh.json has them ("radiance" is raw).
         const shc = !bake.sh ? [] : bake.sh.irradiance_over_pi_shader_windowed || bake.sh.irradiance_over_pi_shader || [];
         this.sh = new Float32Array(27);
@@ -280,7 +298,13 @@ class Renderer {
         gl.activeTexture(gl.TEXTURE3);
         gl.bindTexture(gl.TEXTURE_2D, this.lobeTex);
         gl.uniform1i(u('u_lobe'), 3);
-        gl.uniform1i(u('u_runtime'), this.bake.model === 'lobe' ? 1 : 0);
+        gl.activeTexture(gl.TEXTURE4);
+        gl.bindTexture(gl.TEXTURE_2D, this.tapsATex);
+        gl.uniform1i(u('u_taps_a'), 4);
+        gl.activeTexture(gl.TEXTURE5);
+        gl.bindTexture(gl.TEXTURE_2D, this.tapsBTex);
+        gl.uniform1i(u('u_taps_b'), 5);
+        gl.uniform1i(u('u_runtime'), this.bake.model === 'lobe' ? 1 : this.bake.model === 'taps2' ? 2 : 0);
         gl.uniform3fv(u('u_sh[0]'), this.sh);
         gl.uniform1i(u('u_diffuse'), rt.diffuse === 'sh' ? 1 : rt.diffuse === 'irradiance_map' && this.bake.irradiance ? 2 : 0);
         const spec = view.lookup === 'textbook' ? { weight: 'lod', interpolation: 'linear' }
@@ -354,6 +378,8 @@ class Renderer {
             runtime_model: this.bake.model,
             lobe_texture: this.lobeFormat,
             lobe_size: this.bake.lobe ? this.bake.lobe.size : 0,
+            taps_texture: this.tapsFormat,
+            taps_size: this.bake.taps ? this.bake.taps.size : 0,
             lut_size: this.bake.dfg.size,
             exposure: this.exposure,
             preview_ss: this.previewSs,
@@ -522,7 +548,7 @@ async function runViewer() {
             const i = renderer.info();
             log(`${bake.label}: chain ${i.chain_levels.join('/')} ${i.chain_format}, LUT ${i.lut_size}^2 (${i.lut_texture}), ` +
                 `lookup ${renderer.rt.spec.name || renderer.rt.spec.weight}, runtime ${i.runtime_model}` +
-                (i.lobe_size ? ` (lobe LUT ${i.lobe_size}^2)` : '') + `, diffuse ${renderer.rt.diffuse}, ` +
+                (i.lobe_size ? ` (lobe LUT ${i.lobe_size}^2)` : '') + (i.taps_size ? ` (two-tap table ${i.taps_size}^2)` : '') + `, diffuse ${renderer.rt.diffuse}, ` +
                 `sun ${bake.sun ? bake.sun.solidAngle.toPrecision(3) + ' sr' : 'none'}\n${i.renderer}`);
             redraw();
         } catch (e) {

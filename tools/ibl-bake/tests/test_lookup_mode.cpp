@@ -1,9 +1,11 @@
 // tools/ibl-bake/tests/test_lookup_mode.cpp — `ibl-bake --lookup DIR` answers as the library's
 // runtime functions do on the files of DIR. A tiny bake is made; the test loads its files itself
 // (specular.ktx2 decoded to an ibl::cubemap, dfg.exr to an ibl::dfg_lut, sh.json's shader
-// coefficients, lobe_lut.exr) and evaluates ibl::specular_lookup, ibl::dfg_lookup,
-// ibl::sh_shader_evaluate, ibl::lobe_lut_lookup and pbr_shader::ambient (multiple scattering) on
-// the bake's runtime model (the default: ibl::specular_lobe; split-sum: LD(R, r) DFG) at the
+// coefficients, lobe_lut.exr, lobe_taps_a.exr + lobe_taps_b.exr) and evaluates
+// ibl::specular_lookup, ibl::dfg_lookup, ibl::sh_shader_evaluate, ibl::lobe_lut_lookup, the
+// two-tap table's bilinear read and pbr_shader::ambient (multiple scattering) on the bake's
+// runtime model (the default: ibl::specular_lobe; taps2: ibl::specular_lobe_taps; split-sum:
+// LD(R, r) DFG) at the
 // same queries; every answer must agree to float precision (relative 2e-6, about 16 float ulps:
 // the answers are printed with 9 digits). Malformed queries get an error line each and exit
 // status 1; comments and blank lines get no answer.
@@ -31,6 +33,7 @@
 
 #include <ibl/integrate/dfg_lut.hpp>
 #include <ibl/integrate/disk_light.hpp>
+#include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/integrate/lobe_lut.hpp>
 #include <ibl/lookup.hpp>
 #include <ibl/runtime.hpp>
@@ -79,6 +82,38 @@ dvec3 lobe_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const
     const ibl::vec4<float> p = ibl::lobe_lut_lookup(lobe, ibl::saturate(glm::dot(fn, fv)), float(r), layout);
     const fvec3 e = ibl::specular_lobe(chain, ibl::specular_lookup_desc{}, lobe, layout, fn, fv, float(r), fvec3(1.0f), fvec3(1.0f));
     return dvec3(e) / double(ibl::saturate(p.x) + ibl::saturate(p.y));
+}
+
+/// The two-tap table from its two RGBA files (channels 0..3 and 4..7).
+ibl::lobe_taps_lut load_taps(const std::string& a_path, const std::string& b_path) {
+    const image_rgba32f a = read_exr_rgba(a_path), b = read_exr_rgba(b_path);
+    REQUIRE(a.width == b.width);
+    ibl::lobe_taps_lut lut;
+    lut.size = std::uint32_t(a.width);
+    lut.taps = 2;
+    lut.channels = 8;
+    for (std::size_t k = 0; k < std::size_t(lut.size) * lut.size; ++k) {
+        for (std::size_t c = 0; c < 4; ++c) lut.data.push_back(a.rgba[4 * k + c]);
+        for (std::size_t c = 0; c < 4; ++c) lut.data.push_back(b.rgba[4 * k + c]);
+    }
+    return lut;
+}
+
+/// The table's 8 channels at (n.v, r): one bilinear read in the DFG layout.
+std::vector<double> taps_read(const ibl::lobe_taps_lut& t, double n_dot_v, double r) {
+    const ibl::vec2<float> st = ibl::dfg_lut_coord(float(n_dot_v), float(r), t.size, ibl::dfg_lut_layout{});
+    float p[8] = {};
+    ibl::detail::table_bilinear(t, st.x, st.y, p, 8);
+    return std::vector<double>(p, p + 8);
+}
+
+/// LD of the two-tap model at (n, v, r): ibl::specular_lobe_taps with F0 = F90 = 1 gives LD (A + B).
+dvec3 taps_ld(const ibl::cubemap<float>& chain, const ibl::lobe_taps_lut& t, const dvec3& n, const dvec3& v, double r) {
+    const fvec3 fn(n), fv(v);
+    const std::vector<double> p = taps_read(t, ibl::saturate(glm::dot(fn, fv)), r);
+    const fvec3 e = ibl::specular_lobe_taps(chain, ibl::specular_lookup_desc{}, t, ibl::dfg_lut_layout{}, fn, fv, float(r),
+                                            fvec3(1.0f), fvec3(1.0f));
+    return dvec3(e) / double(ibl::saturate(float(p[0])) + ibl::saturate(float(p[1])));
 }
 
 ibl::sh_coeffs<double, 3> load_sh(const std::string& path) {
@@ -229,6 +264,51 @@ TEST_CASE("lookup: a split-sum bake shades with LD(R, r) and the DFG table, and 
     std::ofstream(s / "q2.txt") << "lobe 0.5 0.5\n";
     CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
     CHECK(slurp(s / "a2.txt").find("no lobe LUT") != std::string::npos);
+}
+
+TEST_CASE("lookup: a taps2 bake shades with ibl::specular_lobe_taps and answers taps from its two files") {
+    scratch s("ibl_bake_lookup_taps");
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --runtime taps2 --out " +
+                  (s / "bake") + " >/dev/null 2>&1") == 0);
+    CHECK_FALSE(fs::exists(s / "bake/lobe_lut.exr"));
+    const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
+    const ibl::lobe_taps_lut taps = load_taps(s / "bake/lobe_taps_a.exr", s / "bake/lobe_taps_b.exr");
+    CHECK(taps.size == 16); // at most the DFG table's size
+    const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
+    std::string q;
+    std::vector<std::vector<double>> want;
+    for (int k = 0; k < 16; ++k) {
+        const dvec3 n = glm::normalize(dvec3(std::sin(0.7 * k), 0.5, std::cos(0.3 * k))), v = glm::normalize(n + dvec3(0.4, 0.2, -0.3 + 0.1 * k));
+        const double r = std::fmod(0.067 * k + 0.01, 1.0), nv = std::fmod(0.071 * k + 0.003, 1.0);
+        char buf[320];
+        std::snprintf(buf, sizeof buf, "shade %.17g %.17g %.17g %.17g %.17g %.17g %.17g %d 0.9 0.6 0.5\ntaps %.17g %.17g\n", n.x, n.y, n.z,
+                      v.x, v.y, v.z, r, k % 2, nv, r);
+        q += buf;
+        ibl::pbr_material<double> m;
+        m.roughness = r;
+        m.metallic = k % 2;
+        m.base_color = dvec3(0.9, 0.6, 0.5);
+        const double ndv = std::clamp(glm::dot(n, v), 0.0, 1.0);
+        const std::vector<double> p = taps_read(taps, ndv, r);
+        ibl::ibl_sample<double> smp;
+        smp.ld = taps_ld(chain, taps, n, v, r);
+        smp.dfg = ibl::vec2<double>(p[0], p[1]);
+        smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, n), dvec3(0.0));
+        const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
+        want.push_back({lo.x, lo.y, lo.z});
+        want.push_back(taps_read(taps, nv, r));
+    }
+    std::ofstream(s / "q.txt") << q;
+    REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
+    check_answers(slurp(s / "a.txt"), want);
+    // the other bakes have no taps answer, this one no lobe answer
+    std::ofstream(s / "q2.txt") << "lobe 0.5 0.5\n";
+    CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
+    CHECK(slurp(s / "a2.txt").find("no lobe LUT") != std::string::npos);
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --out " + (s / "lobe") + " >/dev/null 2>&1") == 0);
+    std::ofstream(s / "q3.txt") << "taps 0.5 0.5\n";
+    CHECK(shell(tool + " --lookup " + (s / "lobe") + " < " + (s / "q3.txt") + " > " + (s / "a3.txt")) == 1);
+    CHECK(slurp(s / "a3.txt").find("bake with --runtime taps2") != std::string::npos);
 }
 
 TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers are about the whole environment") {

@@ -85,6 +85,8 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     CHECK(fil.find("plan")->find("runtime")->find("ld_weight")->find("name")->string == "nl");
     CHECK_FALSE(fs::exists(s / "fil/lobe_lut.exr"));
     CHECK_FALSE(fs::exists(s / "gltf/lobe_lut.exr"));
+    for (const char* d : {"fil", "gltf"}) // nor the two-tap table
+        for (const char* f : {"lobe_taps_a.exr", "lobe_taps_b.exr", "lobe_taps.hpp"}) CHECK_FALSE(fs::exists(s / (std::string(d) + "/" + f)));
     CHECK(kv["ibl.first_level"] == "0");
     CHECK(kv["ibl.virtual_levels"] == "4");
     CHECK(kv["ibl.policy"].rfind("filament", 0) == 0);

@@ -9,6 +9,7 @@
 #include "ktx2.hpp"
 
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -271,8 +272,69 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     const std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
     CHECK(kv.at("ibl.ld_weight") == "g1");
     CHECK(kv.at("ibl.runtime") == "lobe");
+    CHECK_FALSE(fs::exists(out + "/lobe_taps_a.exr")); // the two-tap table only with --runtime taps2
+    CHECK_FALSE(rep.has("lobe_taps"));
     // nothing else in the parent: the staging directory is gone
     CHECK(entries(s.path) == std::set<std::string>{"bake", "stderr.txt", "stdout.txt"});
+}
+
+TEST_CASE("full run: --runtime taps2 writes the two-tap table and measures its model") {
+    scratch_dir s("taps2");
+    const std::string out = s / "bake";
+    const run_result r = run(s, with(tiny, {"--runtime", "taps2", "--out", out}));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.out.find("lobe taps") != std::string::npos);
+    CHECK(r.out.find("taps2 metal r=0.9") != std::string::npos);
+    CHECK(r.out.find("split sum metal r=0.9") != std::string::npos);
+    CHECK_FALSE(fs::exists(out + "/lobe_lut.exr"));
+    CHECK_FALSE(fs::exists(out + "/lobe_lut.hpp"));
+    const json rep = parse_json(slurp(out + "/report.json"));
+    CHECK(rep["plan"]["runtime"]["runtime_model"]["name"].str == "taps2");
+    CHECK(rep["plan"]["runtime"]["runtime_model"]["lut_size"].number == 16);
+    CHECK(rep["plan"]["runtime"]["ld_weight"]["name"].str == "g1"); // the preset's chain weight
+    CHECK(rep["split_sum"]["runtime_model"].str == "taps2");
+    CHECK(rep["split_sum"]["materials"].items.size() == 6);
+    CHECK(rep["split_sum"]["materials_split_sum"].items.size() == 6);
+    CHECK_FALSE(rep.has("lobe_lut"));
+    const json& t = rep["lobe_taps"];
+    CHECK(t["size"].number == 16); // at most the DFG table's size
+    CHECK(t["weight"].str == "g1");
+    CHECK(t["taps"].number == 2);
+    CHECK(t["nodes"].number == 32);
+    CHECK(t["iterations"].number == 150);
+    CHECK(t["time_ms"].kind == json::number_v);
+    CHECK(t["fit"]["mean_l1"].number > 0.0);
+    CHECK(t["fit"]["mean_l1"].number <= t["fit"]["max_l1"].number);
+    CHECK(t["fit"]["max_l1"].number <= 2.0);
+    CHECK(t["check"]["ab_vs_dfg_max_abs"].number < 5e-2);
+    CHECK(t["check"]["midpoints"].number > 0);
+    CHECK(t["check"]["l1"]["table_mean"].number >= 0.0);
+    CHECK(t["check"]["l1"]["direct_fit_mean"].number >= 0.0);
+    const image_rgba32f a = read_exr_rgba(out + "/lobe_taps_a.exr"), b = read_exr_rgba(out + "/lobe_taps_b.exr");
+    CHECK(a.width == 16);
+    CHECK(b.width == 16);
+    REQUIRE(a.rgba.size() == 16 * 16 * 4);
+    REQUIRE(b.rgba.size() == 16 * 16 * 4);
+    // row 0 = r = 0 (edge-aligned), texel (0, 0) at n.v = 0: the mirror, one tap at R (angle pi/2)
+    CHECK(a.rgba[2] == 1.0f);
+    CHECK(a.rgba[3] == 0.0f);
+    CHECK(b.rgba[0] == 1.0f);
+    CHECK(b.rgba[3] == 0.0f);
+    for (std::size_t k = 0; k < 16 * 16; ++k) { // the weights sum to 1, angles between n and the horizon
+        CHECK(b.rgba[4 * k] + b.rgba[4 * k + 3] == doctest::Approx(1.0).epsilon(1e-5));
+        CHECK(std::fabs(a.rgba[4 * k + 2]) <= 1.0f);
+        CHECK(std::fabs(b.rgba[4 * k + 1]) <= 1.0f);
+    }
+    const std::string hpp = slurp(out + "/lobe_taps.hpp");
+    CHECK(hpp.find("lobe_taps_size = 16;") != std::string::npos);
+    CHECK(hpp.find("lobe_taps_channels = 8;") != std::string::npos);
+    CHECK(hpp.find("lobe_taps[2048]") != std::string::npos);
+    const std::string ktx = slurp(out + "/specular.ktx2");
+    const ktx2_info info = parse_ktx2(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(ktx.data()), ktx.size()));
+    const std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
+    CHECK(kv.at("ibl.runtime") == "taps2");
+    CHECK(kv.at("ibl.ld_weight") == "g1");
 }
 
 TEST_CASE("deterministic: bit-identical outputs with 1 and 2 threads") {
@@ -307,6 +369,8 @@ TEST_CASE("bad options: exit 2 with a message, nothing created") {
         {"--out", out, "--quality", "ultra"},
         {"--out", out, "--ld-weight", "g2"},
         {"--out", out, "--runtime", "lobes"},
+        {"--out", out, "--runtime", "taps3"},
+        {"--out", out, "--runtime", "Taps2"},
         {"--out", out, "--levels", "9", "--size", "16"},
         {"--size", "16"},
         {"stray", "--out", out},
