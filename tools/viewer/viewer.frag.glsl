@@ -54,34 +54,10 @@ vec3 diffuse_over_pi(vec3 n) {
     return vec3(0.0);
 }
 
-// The two-tap model's sample: ibl_specular_lobe_taps2's LD (its taps, their weighted mean; LD(R, r)
-// where no weight is > 0) and its (A, B), for ibl_ambient to apply the albedo (as ibl-bake's
-// product_view::sample does).
-ibl_sample taps2_sample(vec3 n, vec3 v, float roughness, vec3 irradiance_over_pi) {
-    ibl_specular_desc sd = spec_desc();
-    vec3 r_dir = 2.0 * dot(n, v) * n - v;
-    vec2 st = ibl_dfg_lut_coord(ibl_saturate(dot(n, v)), roughness, textureSize(u_taps_a, 0).x, dfg_layout());
-    vec4 pa = textureLod(u_taps_a, st, 0.0);
-    vec4 pb = textureLod(u_taps_b, st, 0.0);
-    vec3 t = ibl_incidence_tangent(n, r_dir);
-    vec3 sum = vec3(0.0);
-    float wsum = 0.0;
-    if (pb.x > 0.0) {
-        sum += pb.x * ibl_specular_lookup(u_chain, ibl_lobe_tap_direction(n, t, pa.z), pa.w, sd);
-        wsum += pb.x;
-    }
-    if (pb.w > 0.0) {
-        sum += pb.w * ibl_specular_lookup(u_chain, ibl_lobe_tap_direction(n, t, pb.y), pb.z, sd);
-        wsum += pb.w;
-    }
-    vec3 ld = wsum > 0.0 ? sum / wsum : ibl_specular_lookup(u_chain, r_dir, roughness, sd);
-    return ibl_sample(ld, irradiance_over_pi, pa.xy);
-}
-
 vec3 shade_sphere(vec3 n, vec3 v, ibl_material mat) {
     ibl_material_terms m = ibl_resolve_material(mat);
     ibl_sample s; // (WebGL forbids ?: on structures)
-    if (u_runtime == 2) s = taps2_sample(n, v, m.roughness, diffuse_over_pi(n));
+    if (u_runtime == 2) s = ibl_lobe_taps2_sample(u_chain, spec_desc(), u_taps_a, u_taps_b, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     else if (u_runtime == 1) s = ibl_lobe_sample(u_chain, spec_desc(), u_lobe, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     else s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     vec3 c = ibl_ambient(m, clamp(dot(n, v), 0.0, 1.0), s, u_spec_rule.z != 0);

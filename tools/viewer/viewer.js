@@ -18,7 +18,7 @@
 // environment without it), lobe_lut.hpp (when plan.runtime.runtime_model.name is "lobe": the lobe
 // LUT, and the spheres are shaded by the lobe model, ibl_lobe_sample), lobe_taps.hpp (when it is
 // "taps2": the two-tap table, uploaded as the two RGBA textures of ibl_common.glsl's storage split,
-// and the spheres are shaded by the two-tap model, ibl_specular_lobe_taps2's LD); else by the split
+// and the spheres are shaded by the two-tap model, ibl_lobe_taps2_sample); else by the split
 // sum.
 
 import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';

@@ -298,17 +298,17 @@ vec3 ibl_lobe_tap_direction(vec3 n, vec3 t, float angle01) {
     return normalize(cos(a) * n + sin(a) * t);
 }
 
-// The two-tap fitted model (specular_lobe_taps of a 2-tap lobe_taps_lut): at (n.v, r) one bilinear
-// read of each table (taps_a = A, B, angle0 / (pi/2), roughness0; taps_b = weight0,
-// angle1 / (pi/2), roughness1, weight1; ibl_common.glsl), then
-//     (F0 A + F90 B) sum_k w_k LD(d_k, r_k) / sum_k w_k,   d_k = ibl_lobe_tap_direction(n, t, angle_k)
-// with t = ibl_incidence_tangent(n, R), each LD by the chain lookup sd; LD(R, r) where no weight
-// is > 0. Cost: two chain lookups and two RGBA table reads.
-vec3 ibl_specular_lobe_taps2(samplerCube chain, ibl_specular_desc sd, sampler2D taps_a, sampler2D taps_b,
-                             ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90) {
-    float n_dot_v = ibl_saturate(dot(n, v));
+// The products at a shading point through the two-tap fitted model (specular_lobe_taps of a 2-tap
+// lobe_taps_lut): at (n.v, r) one bilinear read of each table (taps_a = A, B, angle0 / (pi/2),
+// roughness0; taps_b = weight0, angle1 / (pi/2), roughness1, weight1; ibl_common.glsl), then
+//     LD = sum_k w_k LD(d_k, r_k) / sum_k w_k,   d_k = ibl_lobe_tap_direction(n, t, angle_k)
+// with t = ibl_incidence_tangent(n, R), each LD by the chain lookup sd (LD(R, r) where no weight
+// is > 0), and (A, B) as the sample's dfg; E/pi passed through. ibl_ambient on it is the two-tap
+// model. Cost: two chain lookups and two RGBA table reads.
+ibl_sample ibl_lobe_taps2_sample(samplerCube chain, ibl_specular_desc sd, sampler2D taps_a, sampler2D taps_b,
+                                 ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 irradiance_over_pi) {
     vec3 r_dir = 2.0 * dot(n, v) * n - v;
-    vec2 st = ibl_dfg_lut_coord(n_dot_v, roughness, textureSize(taps_a, 0).x, lay);
+    vec2 st = ibl_dfg_lut_coord(ibl_saturate(dot(n, v)), roughness, textureSize(taps_a, 0).x, lay);
     vec4 pa = textureLod(taps_a, st, 0.0);
     vec4 pb = textureLod(taps_b, st, 0.0);
     vec3 t = ibl_incidence_tangent(n, r_dir);
@@ -323,7 +323,14 @@ vec3 ibl_specular_lobe_taps2(samplerCube chain, ibl_specular_desc sd, sampler2D 
         wsum += pb.w;
     }
     vec3 ld = wsum > 0.0 ? sum / wsum : ibl_specular_lookup(chain, r_dir, roughness, sd);
-    return ld * ibl_split_sum_albedo(f0, f90, pa.xy);
+    return ibl_sample(ld, irradiance_over_pi, pa.xy);
+}
+
+// The two-tap model's specular (F0 A + F90 B) LD of ibl_lobe_taps2_sample.
+vec3 ibl_specular_lobe_taps2(samplerCube chain, ibl_specular_desc sd, sampler2D taps_a, sampler2D taps_b,
+                             ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90) {
+    ibl_sample s = ibl_lobe_taps2_sample(chain, sd, taps_a, taps_b, lay, n, v, roughness, vec3(0.0));
+    return ibl_specular_ibl(s.ld, f0, f90, s.dfg);
 }
 
 #endif // IBL_GLSL_RUNTIME
