@@ -252,11 +252,18 @@ template <class T> IBL_FUNC vec3<T> incidence_tangent(const vec3<T>& n, const ve
     return len2 > T(1e-12) ? t * (T(1) / sqrt(len2)) : make_frame(n).t;
 }
 
+/// A fitted tap's angle from n towards R (radians) from its table value f: f acos(n.v) (f = 1 at
+/// R, 0 at n; integrate/lobe_fit.hpp stores angles relative to the view angle).
+template <class T> IBL_FUNC T lobe_tap_angle(T stored, T n_dot_v) noexcept {
+    using std::acos;
+    return stored * acos(saturate(n_dot_v));
+}
+
 /// The fitted-taps model (integrate/lobe_fit.hpp) from a table with members size, channels, taps
 /// and data (lobe_taps_lut fitted with kernels of any roughness, i.e. empty level_roughness: a
 /// table of stored levels holds lods there, which this does not read): at (n.v, r) one bilinear
 /// read of the channels
-/// (A, B, then angle / (pi/2), roughness, weight per tap), then
+/// (A, B, then angle / acos(n.v), roughness, weight per tap), then
 ///     Lo_s ~ (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k)
 /// with t = incidence_tangent(n, R) and each LD by the chain lookup sd. Cost: taps chain lookups
 /// and ceil((2 + 3 taps) / 4) RGBA table reads.
@@ -275,7 +282,7 @@ vec3<float> specular_lobe_taps(const cubemap<float>& chain, const specular_looku
     vec3<float> sum(0.0f);
     float wsum = 0.0f;
     for (int k = 0; k < taps; ++k) {
-        const float a = p[2 + 3 * k] * half_pi_v<float>, w = p[4 + 3 * k];
+        const float a = lobe_tap_angle(p[2 + 3 * k], n_dot_v), w = p[4 + 3 * k];
         if (!(w > 0.0f)) continue;
         const vec3<float> d = glm::normalize(std::cos(a) * n + std::sin(a) * t);
         sum += w * specular_lookup(chain, d, p[3 + 3 * k], sd);

@@ -50,7 +50,7 @@ void main() {
                ibl_fis_combine(tap.weight, tap.weight, 4, false, m.f0, ld) + ibl_frame_to_world(fr, tap.dir) * tap.roughness;
     vec3 it = ibl_incidence_tangent(u_n, u_l);
     vec3 lt = ibl_specular_lobe_taps2(u_chain, sd, u_taps_a, u_taps_b, lay, u_n, u_v, u_r, m.f0, m.f90) +
-              ibl_lobe_tap_direction(u_n, it, 0.5);
+              ibl_lobe_tap_direction(u_n, it, ibl_lobe_tap_angle(0.5, u_r));
     float so = ibl_specular_occlusion_table(u_so, dot(u_n, u_v), u_r, 0.5) +
                ibl_specular_occlusion_bent(u_so, u_n, u_v, it, u_r, 0.5) + ibl_specular_occlusion_coord(0.5, u_r, 0.5, 8).z;
     o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so, 1.0);

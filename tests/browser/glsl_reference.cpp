@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -62,8 +63,8 @@ const ibl::cubemap<float>& fixture_chain() {
     return chain;
 }
 
-/// The two-tap table (lobe_taps_lut's members): 4^2 texels of 8 channels (A, B, angle0 / (pi/2),
-/// r0, w0, angle1 / (pi/2), r1, w1), smooth in (i, j), both weights 0 at texels (0, 0) and (1, 0)
+/// The two-tap table (lobe_taps_lut's members): 4^2 texels of 8 channels (A, B, angle0 / acos(n.v),
+/// r0, w0, angle1 / acos(n.v), r1, w1), smooth in (i, j), both weights 0 at texels (0, 0) and (1, 0)
 /// (the fallback), weight 0 of tap 1 on row 0.
 struct taps_table {
     std::uint32_t size = 4, channels = 8;
@@ -316,7 +317,9 @@ v4 fis_bound(int i, std::uint32_t taps, float c, bool normalise, bool textbook, 
 /// The taps row's per-value bound: each table channel read within 1e-5 (the sampler coordinate,
 /// formed with pow and a division, within a few ulp, times N = 4 texels, times neighbouring
 /// channel differences < 1), each tap direction within 2 trig_eps + 1e-5 (cos, sin of float angles;
-/// normalize) plus the angle's error pi/2 1e-5, the roughness within 1e-5, and the combination as
+/// normalize) plus the angle's error: f acos(n.v) with f within 1e-5 and acos within trig_eps (as
+/// sin and cos: Vulkan's atan2-derived bound) plus its response to n.v's rounding (a few ulp near
+/// n.v = 1, where acos has a square root: sqrt(8 eps)), the roughness within 1e-5, and the combination as
 /// in fis_bound (normalised); A, B within 1e-5 enter the albedo.
 v4 taps_bound(int i, float r, const v3& f0, const v3& f90, bool textbook) {
     const auto& chain = fixture_chain();
@@ -330,13 +333,16 @@ v4 taps_bound(int i, float r, const v3& f0, const v3& f90, bool textbook) {
     ibl::detail::table_bilinear(lut, st.x, st.y, p, 8);
     const v3 t = ibl::incidence_tangent(n, r_dir);
     constexpr double dp = 1e-5;
-    const double dd = 2.0 * trig_eps + 1e-5 + ibl::half_pi_v<double> * dp + dir_floor;
+    const double angle_err = std::max(std::fabs(double(p[2])), std::fabs(double(p[5]))) *
+                                 (trig_eps + std::sqrt(8.0 * double(std::numeric_limits<float>::epsilon()))) +
+                             std::acos(double(n_dot_v)) * dp;
+    const double dd = 2.0 * trig_eps + 1e-5 + angle_err + dir_floor;
     v3d sum(0.0), dsum(0.0);
     double wsum = 0.0, dwsum = 0.0;
     std::vector<v3d> lds;
     std::vector<double> ws;
     for (int k = 0; k < 2; ++k) {
-        const float a = p[2 + 3 * k] * ibl::half_pi_v<float>, w = p[4 + 3 * k];
+        const float a = ibl::lobe_tap_angle(p[2 + 3 * k], n_dot_v), w = p[4 + 3 * k];
         if (!(w > 0.0f)) {
             // a weight of 0 interpolated from non-zero texels (bilinear weight 0) may be read as
             // up to dp, with a lookup below 3.5 (the chain's largest channel)

@@ -92,10 +92,11 @@ dvec3 taps_ld(const product_view& pv, const std::array<float, 8>& p, const dvec3
     const fvec3 fn(n), fv(v);
     const fvec3 r_dir = 2.0f * glm::dot(fn, fv) * fn - fv;
     const fvec3 t = ibl::incidence_tangent(fn, r_dir);
+    const float n_dot_v = ibl::saturate(glm::dot(fn, fv));
     dvec3 sum(0.0);
     double wsum = 0.0;
     for (int k = 0; k < 2; ++k) {
-        const float a = p[std::size_t(2 + 3 * k)] * ibl::half_pi_v<float>, w = p[std::size_t(4 + 3 * k)];
+        const float a = ibl::lobe_tap_angle(p[std::size_t(2 + 3 * k)], n_dot_v), w = p[std::size_t(4 + 3 * k)];
         if (!(w > 0.0f)) continue;
         const fvec3 d = glm::normalize(std::cos(a) * fn + std::sin(a) * t);
         sum += double(w) * pv.ld(dvec3(d), p[std::size_t(3 + 3 * k)]);
@@ -176,8 +177,8 @@ void json_runtime_model(json_writer& j, const runtime_model& rm) {
                             "LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) (ibl::specular_lobe)");
     } else if (rm.name == "taps2") {
         j.key("lut").value("lobe_taps_a.exr, lobe_taps_b.exr (lobe_taps.hpp)").key("lut_size").value(rm.lobe_lut_size);
-        j.key("channels").value("lobe_taps_a: R = A, G = B, B = angle0 / (pi/2), A = roughness0; lobe_taps_b: R = weight0, "
-                                "G = angle1 / (pi/2), B = roughness1, A = weight1");
+        j.key("channels").value("lobe_taps_a: R = A, G = B, B = angle0 / acos(n.v), A = roughness0; lobe_taps_b: R = weight0, "
+                                "G = angle1 / acos(n.v), B = roughness1, A = weight1");
         j.key("rule").value("the 8 channels = the two tables at (n.v, r) in the DFG layout (bilinear); t = the tangent of n "
                             "towards R; specular = (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k) / sum_k w_k "
                             "(ibl::specular_lobe_taps; LD(R, r) where no weight is > 0)");

@@ -41,8 +41,8 @@
 // Taps LUT  the two-tap fitted model of ibl/runtime.hpp (specular_lobe_taps; lobe_fit.hpp's
 //           make_lobe_taps_lut with taps = 2): its eight channels per texel, in the DFG table's
 //           layout and orientation, as two RGBA textures of the same size: taps_a = channels
-//           0..3 (R = A, G = B, B = angle0 / (pi/2), A = roughness0), taps_b = channels 4..7
-//           (R = weight0, G = angle1 / (pi/2), B = roughness1, A = weight1); tap k reads the
+//           0..3 (R = A, G = B, B = angle0 / acos(n.v), A = roughness0), taps_b = channels 4..7
+//           (R = weight0, G = angle1 / acos(n.v), B = roughness1, A = weight1); tap k reads the
 //           chain at cos(angle_k) n + sin(angle_k) t (t: the tangent of n towards R) and roughness_k.
 //           Clamp to edge, bilinear (RGBA32F: the table's floats).
 // SO LUT    the specular-occlusion table of ibl/occlusion.hpp (specular_occlusion_lut, size^3

@@ -291,35 +291,37 @@ vec3 ibl_incidence_tangent(vec3 n, vec3 r_dir) {
     return len2 > 1e-12 ? t * (1.0 / sqrt(len2)) : ibl_make_frame(n).t;
 }
 
-// The direction of a fitted tap at angle angle01 pi/2 from n towards the tangent t:
+// A fitted tap's angle from n towards R (radians) from its table value f: f acos(n.v)
+// (lobe_tap_angle: 1 = at R, 0 = at n).
+float ibl_lobe_tap_angle(float stored, float n_dot_v) { return stored * acos(ibl_saturate(n_dot_v)); }
+
+// The direction of a fitted tap at angle a (radians) from n towards the tangent t:
 // normalize(cos(a) n + sin(a) t).
-vec3 ibl_lobe_tap_direction(vec3 n, vec3 t, float angle01) {
-    float a = angle01 * (0.5 * IBL_PI);
-    return normalize(cos(a) * n + sin(a) * t);
-}
+vec3 ibl_lobe_tap_direction(vec3 n, vec3 t, float a) { return normalize(cos(a) * n + sin(a) * t); }
 
 // The products at a shading point through the two-tap fitted model (specular_lobe_taps of a 2-tap
-// lobe_taps_lut): at (n.v, r) one bilinear read of each table (taps_a = A, B, angle0 / (pi/2),
-// roughness0; taps_b = weight0, angle1 / (pi/2), roughness1, weight1; ibl_common.glsl), then
-//     LD = sum_k w_k LD(d_k, r_k) / sum_k w_k,   d_k = ibl_lobe_tap_direction(n, t, angle_k)
+// lobe_taps_lut): at (n.v, r) one bilinear read of each table (taps_a = A, B, f0, roughness0;
+// taps_b = weight0, f1, roughness1, weight1; f = angle / acos(n.v); ibl_common.glsl), then
+//     LD = sum_k w_k LD(d_k, r_k) / sum_k w_k,   d_k = ibl_lobe_tap_direction(n, t, f_k acos(n.v))
 // with t = ibl_incidence_tangent(n, R), each LD by the chain lookup sd (LD(R, r) where no weight
 // is > 0), and (A, B) as the sample's dfg; E/pi passed through. ibl_ambient on it is the two-tap
 // model. Cost: two chain lookups and two RGBA table reads.
 ibl_sample ibl_lobe_taps2_sample(samplerCube chain, ibl_specular_desc sd, sampler2D taps_a, sampler2D taps_b,
                                  ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 irradiance_over_pi) {
     vec3 r_dir = 2.0 * dot(n, v) * n - v;
-    vec2 st = ibl_dfg_lut_coord(ibl_saturate(dot(n, v)), roughness, textureSize(taps_a, 0).x, lay);
+    float n_dot_v = ibl_saturate(dot(n, v));
+    vec2 st = ibl_dfg_lut_coord(n_dot_v, roughness, textureSize(taps_a, 0).x, lay);
     vec4 pa = textureLod(taps_a, st, 0.0);
     vec4 pb = textureLod(taps_b, st, 0.0);
     vec3 t = ibl_incidence_tangent(n, r_dir);
     vec3 sum = vec3(0.0);
     float wsum = 0.0;
     if (pb.x > 0.0) {
-        sum += pb.x * ibl_specular_lookup(chain, ibl_lobe_tap_direction(n, t, pa.z), pa.w, sd);
+        sum += pb.x * ibl_specular_lookup(chain, ibl_lobe_tap_direction(n, t, ibl_lobe_tap_angle(pa.z, n_dot_v)), pa.w, sd);
         wsum += pb.x;
     }
     if (pb.w > 0.0) {
-        sum += pb.w * ibl_specular_lookup(chain, ibl_lobe_tap_direction(n, t, pb.y), pb.z, sd);
+        sum += pb.w * ibl_specular_lookup(chain, ibl_lobe_tap_direction(n, t, ibl_lobe_tap_angle(pb.y, n_dot_v)), pb.z, sd);
         wsum += pb.w;
     }
     vec3 ld = wsum > 0.0 ? sum / wsum : ibl_specular_lookup(chain, r_dir, roughness, sd);

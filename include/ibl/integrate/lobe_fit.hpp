@@ -135,6 +135,10 @@ struct lobe_fit_options {
     /// Nelder-Mead stops once its simplex's objective values agree within this (L1 units; 0:
     /// always the full iteration count).
     double tolerance = 1e-5;
+    /// A tap that lowers the objective by less than this is not placed: its weight goes to an
+    /// identical copy of the heaviest tap. Tables then stay continuous where an extra tap has no
+    /// use (at n.v = 1 one kernel of a G1 chain is exact, and any split of it fits as well).
+    double min_gain = 5e-3;
 };
 
 namespace detail {
@@ -348,15 +352,20 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     }
     const double spread = 0.5 * std::max(r_eff * r_eff, 0.02);
     double best = 2.0;
+    std::vector<double> x_same; // the k - 1 taps' mixture written with k taps (no new freedom used)
+    double best_same = 2.0;
     for (int nk = 1; nk <= n_taps; ++nk) {
         if (nk > 1) { // split the heaviest tap
             int h = 0;
             for (int k = 1; k < nk - 1; ++k)
                 if (x[std::size_t(3 * k + 2)] > x[std::size_t(3 * h + 2)]) h = k;
             const double a = x[std::size_t(3 * h)], v = x[std::size_t(3 * h + 1)], wt = x[std::size_t(3 * h + 2)];
-            x[std::size_t(3 * h)] = a - 0.5 * spread;
             x[std::size_t(3 * h + 2)] = 0.5 * wt;
-            x.insert(x.end(), {a + 0.5 * spread, v, 0.5 * wt});
+            x.insert(x.end(), {a, v, 0.5 * wt});
+            x_same = x;
+            best_same = best;
+            x[std::size_t(3 * h)] = a - 0.5 * spread;
+            x[x.size() - 3] = a + 0.5 * spread;
         }
         auto f = [&](const double* p) {
             std::array<lobe_tap, lobe_max_taps> t{};
@@ -370,6 +379,10 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
         std::vector<double> step(x.size());
         for (std::size_t j = 0; j < x.size(); ++j) step[j] = j % 3 == 0 ? spread : j % 3 == 1 ? 0.1 * vmax : 0.2;
         best = detail::nelder_mead(f, x, step, o.iterations * int(x.size()), o.tolerance);
+        if (nk > 1 && !(best < best_same - o.min_gain)) { // the new tap does not pay: keep the copy
+            x = x_same;
+            best = best_same;
+        }
         // weights as parameters: renormalise so the next split starts from the same mixture
         double ws = 0.0;
         for (int k = 0; k < nk; ++k) ws += std::max(x[std::size_t(3 * k + 2)], 0.0);
@@ -385,8 +398,11 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
 /// A table of fitted mixtures in a DFG layout (lookup.hpp): texel (i, j) at
 /// n.v = dfg_texel_value(layout.n_dot_v, i), r = dfg_texel_value(layout.roughness, j); channels
 /// 2 + 3 taps: A, B (make_dfg_lut_exact), then per tap (ascending angle) the angle from n towards
-/// R over pi / 2, the roughness (or lod over levels - 1 for a fit of stored levels) and the weight.
-/// The mirror row r = 0 holds one tap at R (angle acos(n.v)) of roughness 0.
+/// R over the view angle acos(n.v) (1 = at R, 0 = at n; runtime.hpp's lobe_tap_angle), the
+/// roughness (or lod over levels - 1 for a fit of stored levels) and the weight. Relative angles
+/// interpolate between texels where absolute ones cannot: a narrow lobe sits at R, whose angle
+/// changes fast near n.v = 1 (a bilinear read of absolute angles missed it by 6 degrees there).
+/// The mirror row r = 0 holds one tap at R (1) of roughness 0.
 struct lobe_taps_lut {
     std::uint32_t size = 0;
     std::uint32_t channels = 0;
@@ -422,7 +438,7 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
                 t[0] = ab.data[(j * size + ii) * 2];
                 t[1] = ab.data[(j * size + ii) * 2 + 1];
                 if (r <= 0.0) {
-                    t[2] = float(std::acos(saturate(mu)) / half_pi_v<double>);
+                    t[2] = 1.0f; // at R
                     t[3] = 0.0f;
                     t[4] = 1.0f;
                     continue;
@@ -431,11 +447,12 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
                 // taps instead drifts into worse minima: mean L1 0.80 against 0.71 for one tap,
                 // 0.70 against 0.58 for two, and never gained more than 0.01 on a texel.)
                 const lobe_mixture m = fit_specular_lobe<Model>(mu, r, w, o);
+                const double view_angle = std::acos(clamp(mu, 1e-3, std::cos(lobe_min_theta))); // as the fit's
                 // statistics: not the n.v = 0 column (no lobe) nor the near-mirror rows r < 0.05 (the
                 // kernels' roughness floor 0.01 is wider than those lobes; the chain reads level 0)
                 if (t[0] + t[1] > 1e-6f && r >= 0.05) l1[j * size + ii] = m.l1;
                 for (int k = 0; k < lut.taps; ++k) {
-                    t[2 + 3 * k] = float(m.taps[std::size_t(k)].angle / half_pi_v<double>);
+                    t[2 + 3 * k] = float(m.taps[std::size_t(k)].angle / view_angle);
                     t[3 + 3 * k] = float(m.taps[std::size_t(k)].roughness / vmax);
                     t[4 + 3 * k] = float(m.taps[std::size_t(k)].weight);
                 }
@@ -469,7 +486,7 @@ lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, 
             float* dst = &lut.data[(std::size_t(j) * size + i) * 4];
             const double mu = dfg_texel_value<double>(layout.n_dot_v, i, size, layout.edge_aligned);
             const double theta = std::max(std::acos(saturate(mu)), lobe_min_theta);
-            const double ta = std::tan(double(src[2]) * half_pi_v<double>);
+            const double ta = std::tan(double(src[2]) * std::acos(clamp(mu, 1e-3, std::cos(lobe_min_theta))));
             dst[0] = src[0];
             dst[1] = src[1];
             dst[2] = src[3] > 0.0f ? float(clamp(ta / (std::sin(theta) + ta * (1.0 - std::cos(theta))), 0.0, 1.0)) : 1.0f;

@@ -316,15 +316,17 @@ TEST_CASE("full run: --runtime taps2 writes the two-tap table and measures its m
     CHECK(b.width == 16);
     REQUIRE(a.rgba.size() == 16 * 16 * 4);
     REQUIRE(b.rgba.size() == 16 * 16 * 4);
-    // row 0 = r = 0 (edge-aligned), texel (0, 0) at n.v = 0: the mirror, one tap at R (angle pi/2)
+    // row 0 = r = 0 (edge-aligned), texel (0, 0) at n.v = 0: the mirror, one tap at R (angle / acos(n.v) = 1)
     CHECK(a.rgba[2] == 1.0f);
     CHECK(a.rgba[3] == 0.0f);
     CHECK(b.rgba[0] == 1.0f);
     CHECK(b.rgba[3] == 0.0f);
-    for (std::size_t k = 0; k < 16 * 16; ++k) { // the weights sum to 1, angles between n and the horizon
+    for (std::size_t k = 0; k < 16 * 16; ++k) { // the weights sum to 1, angles within the horizon
         CHECK(b.rgba[4 * k] + b.rgba[4 * k + 3] == doctest::Approx(1.0).epsilon(1e-5));
-        CHECK(std::fabs(a.rgba[4 * k + 2]) <= 1.0f);
-        CHECK(std::fabs(b.rgba[4 * k + 1]) <= 1.0f);
+        const double nv = std::pow(double(k % 16) / 15.0, 3.0); // the default layout: n.v = (i / (N - 1))^3
+        const double view = std::acos(std::min(1.0, nv));
+        CHECK(std::fabs(a.rgba[4 * k + 2]) * view <= 1.5707964);
+        CHECK(std::fabs(b.rgba[4 * k + 1]) * view <= 1.5707964);
     }
     const std::string hpp = slurp(out + "/lobe_taps.hpp");
     CHECK(hpp.find("lobe_taps_size = 16;") != std::string::npos);
