@@ -157,7 +157,10 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         need(2);
         if (!b.has_taps) throw std::invalid_argument("the bake has no two-tap table (bake with --runtime taps2)");
         std::string s;
-        for (const float x : v.taps_params(unit_interval(a[0]), unit_interval(a[1]))) s += (s.empty() ? "" : " ") + fmt9(x);
+        for (const float x : v.taps_params(unit_interval(a[0]), unit_interval(a[1]))) {
+            if (!s.empty()) s += ' ';
+            s += fmt9(x);
+        }
         return s;
     }
     throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe, taps)");
