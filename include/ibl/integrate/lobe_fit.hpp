@@ -154,25 +154,16 @@ struct lobe_points {
 template <class Model> lobe_points make_lobe_points(double mu, double roughness, std::uint32_t nodes) {
     lobe_points out;
     const double alpha = clamp_alpha(Model::alpha(roughness));
-    const double sin_v = std::sqrt((1.0 - mu) * (1.0 + mu));
-    const vec3<double> v(sin_v, 0.0, mu);
     const double g1_over_nv = ggx_g1_over_n_dot_v(mu, alpha);
     const std::uint32_t q = std::max<std::uint32_t>(nodes, 1);
     double e = 0.0;
-    for (std::uint32_t j = 0; j < q; ++j)
-        for (std::uint32_t i = 0; i < q; ++i) {
-            const vec2<double> u((double(i) + 0.5) / double(q), (double(j) + 0.5) / double(q));
-            const vec3<double> h = sample_ggx_vndf(v, u, alpha);
-            const double vh = glm::dot(v, h);
-            const vec3<double> l = 2.0 * vh * h - v;
-            if (!(l.z > 0.0) || !(vh > 0.0)) continue;
-            const double vis = Model::visibility(mu, l.z, roughness);
-            const double w = 4.0 * vis * l.z / g1_over_nv;
-            out.l.push_back(l);
-            out.weight.push_back(w);
-            out.p.push_back(Model::ndf(h.z, alpha) * vis * l.z); // / E below
-            e += w;
-        }
+    for_each_lobe_draw<Model>(mu, roughness, q, [&](const vec3<double>& l, const vec3<double>& h, double vis) {
+        const double w = 4.0 * vis * l.z / g1_over_nv;
+        out.l.push_back(l);
+        out.weight.push_back(w);
+        out.p.push_back(Model::ndf(h.z, alpha) * vis * l.z); // / E below
+        e += w;
+    });
     out.weight_sum = e;
     e /= double(q) * double(q);
     for (double& p : out.p) p = e > 0.0 ? p / e : 0.0;

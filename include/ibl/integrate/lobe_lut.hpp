@@ -58,22 +58,14 @@ struct lobe_moments {
     double var_major = 0.0, var_minor = 0.0;
 };
 
-/// Moments of the lobe of model M at (n.v, r) (header); nodes^2 points (nodes clamped to
-/// [1, 4096]).
-template <class Model = ggx_height_correlated>
-lobe_moments specular_lobe_moments(double n_dot_v, double roughness, std::uint32_t nodes = 128) {
-    const std::uint32_t q = nodes < 1 ? 1 : (nodes > 4096 ? 4096 : nodes);
-    const double mu = saturate(n_dot_v), r = saturate(roughness);
-    const double alpha = clamp_alpha(Model::alpha(r));
-    const double sin_v = std::sqrt((1.0 - mu) * (1.0 + mu));
-    const vec3<double> v(sin_v, 0.0, mu);
-    const double g1_over_nv = ggx_g1_over_n_dot_v(mu, alpha);
-    double sw = 0.0;
-    vec3<double> sm(0.0);
-    std::vector<vec3<double>> ls;
-    std::vector<double> ws;
-    ls.reserve(std::size_t(q) * q);
-    ws.reserve(std::size_t(q) * q);
+namespace detail {
+/// The specular lobe's visible-normal draws at (n.v, r) in the tangent frame of n with
+/// v = (sin theta, 0, cos theta) (header): a midpoint grid of q^2 points u, h = sample_ggx_vndf,
+/// l = reflect(-v, h); fn(l, h, V(n.v, n.l)) for each draw with l above the horizon (and v.h > 0).
+/// The estimator weight of a draw is f (n.l) / pdf_l = 4 V (n.l) (n.v) / G1(v).
+template <class Model, class Fn> void for_each_lobe_draw(double mu, double roughness, std::uint32_t q, Fn&& fn) {
+    const double alpha = clamp_alpha(Model::alpha(roughness));
+    const vec3<double> v(std::sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
     for (std::uint32_t j = 0; j < q; ++j)
         for (std::uint32_t i = 0; i < q; ++i) {
             const vec2<double> u((double(i) + 0.5) / double(q), (double(j) + 0.5) / double(q));
@@ -81,12 +73,32 @@ lobe_moments specular_lobe_moments(double n_dot_v, double roughness, std::uint32
             const double vh = glm::dot(v, h);
             const vec3<double> l = 2.0 * vh * h - v;
             if (!(l.z > 0.0) || !(vh > 0.0)) continue;
-            const double w = 4.0 * Model::visibility(mu, l.z, r) * l.z / g1_over_nv;
-            sw += w;
-            sm += w * l;
-            ls.push_back(l);
-            ws.push_back(w);
+            fn(l, h, Model::visibility(mu, l.z, roughness));
         }
+}
+} // namespace detail
+
+/// Moments of the lobe of model M at (n.v, r) (header); nodes^2 points (nodes clamped to
+/// [1, 4096]).
+template <class Model = ggx_height_correlated>
+lobe_moments specular_lobe_moments(double n_dot_v, double roughness, std::uint32_t nodes = 128) {
+    const std::uint32_t q = nodes < 1 ? 1 : (nodes > 4096 ? 4096 : nodes);
+    const double mu = saturate(n_dot_v), r = saturate(roughness);
+    const double alpha = clamp_alpha(Model::alpha(r));
+    const double g1_over_nv = ggx_g1_over_n_dot_v(mu, alpha);
+    double sw = 0.0;
+    vec3<double> sm(0.0);
+    std::vector<vec3<double>> ls;
+    std::vector<double> ws;
+    ls.reserve(std::size_t(q) * q);
+    ws.reserve(std::size_t(q) * q);
+    detail::for_each_lobe_draw<Model>(mu, r, q, [&](const vec3<double>& l, const vec3<double>&, double vis) {
+        const double w = 4.0 * vis * l.z / g1_over_nv;
+        sw += w;
+        sm += w * l;
+        ls.push_back(l);
+        ws.push_back(w);
+    });
     lobe_moments out;
     const double n = double(q) * double(q);
     out.albedo = sw / n;

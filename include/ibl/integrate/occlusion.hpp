@@ -71,6 +71,7 @@
 #include "../core/vec.hpp"
 #include "../occlusion.hpp"
 #include "../sampling/ggx.hpp"
+#include "lobe_lut.hpp"
 #include "radiance_reference.hpp"
 
 namespace ibl {
@@ -223,19 +224,11 @@ struct lobe_height_samples {
 template <class Model> lobe_height_samples lobe_heights(double n_dot_v, double roughness, std::uint32_t nodes) {
     const std::uint32_t q = nodes < 1 ? 1 : (nodes > 4096 ? 4096 : nodes);
     const double mu = saturate(n_dot_v), r = saturate(roughness);
-    const double alpha = clamp_alpha(Model::alpha(r));
-    const vec3<double> v(std::sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
     std::vector<std::pair<double, double>> s;
     s.reserve(std::size_t(q) * q);
-    for (std::uint32_t j = 0; j < q; ++j)
-        for (std::uint32_t i = 0; i < q; ++i) {
-            const vec2<double> u((double(i) + 0.5) / double(q), (double(j) + 0.5) / double(q));
-            const vec3<double> h = sample_ggx_vndf(v, u, alpha);
-            const double vh = glm::dot(v, h);
-            const vec3<double> l = 2.0 * vh * h - v;
-            if (!(l.z > 0.0) || !(vh > 0.0)) continue;
-            s.emplace_back(l.z, Model::visibility(mu, l.z, r) * l.z);
-        }
+    for_each_lobe_draw<Model>(mu, r, q, [&](const vec3<double>& l, const vec3<double>&, double vis) {
+        s.emplace_back(l.z, vis * l.z);
+    });
     std::sort(s.begin(), s.end(), [](const auto& a, const auto& b) { return a.first > b.first; });
     lobe_height_samples out;
     out.z.resize(s.size());
