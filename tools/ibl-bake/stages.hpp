@@ -181,9 +181,16 @@ ktx2_format ktx2_format_named(const std::string& name);
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.
 void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
 
-/// The floats of a generated C header's table: 32 per line, 9 significant digits, each with a
-/// decimal point or exponent and the f suffix, comma separated (the body between { and }).
-std::string c_float_list(const std::vector<float>& v);
+/// A square table of `channels` floats per texel as a C header (the layout of dfg.hpp:
+/// name_size, name_channels, name[] row by row, row 0 = the smallest roughness; exact floats):
+/// `what` names the table, `channel_list` its channels, `layout` the texel rule.
+std::string c_table_header(const std::string& name, const std::string& what, std::uint32_t size, std::uint32_t channels,
+                           const std::string& channel_list, const std::string& layout, const std::vector<float>& data);
+
+/// Max |A - A_dfg|, |B - B_dfg| of a table in a DFG layout whose channels 0, 1 are (A, B), against
+/// the DFG table read by ibl::dfg_lookup at the table's texels.
+double ab_vs_dfg(const std::vector<float>& data, std::uint32_t size, std::uint32_t channels, const ibl::dfg_lut_layout& layout,
+                 const ibl::dfg_lut& dfg);
 
 /// Writes an array of RGB triples (the first `count` coefficients).
 void json_triples(json_writer& j, const sh5& c, int count);
