@@ -252,6 +252,20 @@ std::string c_table_header(const std::string& name, const std::string& what, std
     return os.str();
 }
 
+std::vector<std::array<double, 2>> fit_check_midpoints(std::uint32_t n, const ibl::dfg_lut_layout& layout) {
+    std::vector<std::array<double, 2>> out;
+    const auto mid = [&](ibl::dfg_axis a, std::uint32_t k) {
+        return ibl::dfg_axis_value(a, 0.5 * (ibl::dfg_texel_coord<double>(k, n, layout.edge_aligned) +
+                                             ibl::dfg_texel_coord<double>(k + 1, n, layout.edge_aligned)));
+    };
+    for (std::uint32_t j = 0; j + 1 < n; j += 2)
+        for (std::uint32_t i = 0; i + 1 < n; i += 2) {
+            const double nv = mid(layout.n_dot_v, i), r = mid(layout.roughness, j);
+            if (r >= 0.05 && nv >= 1e-3) out.push_back({nv, r});
+        }
+    return out;
+}
+
 double ab_vs_dfg(const std::vector<float>& data, std::uint32_t n, std::uint32_t channels, const ibl::dfg_lut_layout& layout,
                  const ibl::dfg_lut& dfg) {
     double m = 0.0;

@@ -25,7 +25,6 @@ namespace ibl_bake {
 namespace {
 
 constexpr std::uint32_t check_nodes = 32; ///< nodes^2 lobe points of the midpoint check's L1 distances
-constexpr std::uint32_t cell_stride = 2;  ///< midpoint check: every second cell per axis
 
 /// L1 distances at the midpoints: of the table's tap, of a direct fit, of the moment match.
 struct midpoint_l1 {
@@ -90,15 +89,7 @@ ibl::lobe_tap tap_of(double n_dot_v, double s, double r_eff) {
 void lobe_lut_stage::check_midpoints(pool_executor& ex) {
     const std::uint32_t n = lut_->size;
     std::vector<std::array<double, 5>> pts; // n.v, r, L1 of the table's tap, of a direct fit, of the moments
-    for (std::uint32_t j = 0; j + 1 < n; j += cell_stride)
-        for (std::uint32_t i = 0; i + 1 < n; i += cell_stride) {
-            const auto mid = [&](ibl::dfg_axis a, std::uint32_t k) {
-                return ibl::dfg_axis_value(a, 0.5 * (ibl::dfg_texel_coord<double>(k, n, layout_.edge_aligned) +
-                                                     ibl::dfg_texel_coord<double>(k + 1, n, layout_.edge_aligned)));
-            };
-            const double nv = mid(layout_.n_dot_v, i), r = mid(layout_.roughness, j);
-            if (r >= 0.05 && nv >= 1e-3) pts.push_back({nv, r, 0.0, 0.0, 0.0}); // as the fit's statistics
-        }
+    for (const auto& m : fit_check_midpoints(n, layout_)) pts.push_back({m[0], m[1], 0.0, 0.0, 0.0});
     ex(pts.size(), [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const double nv = pts[k][0], r = pts[k][1];

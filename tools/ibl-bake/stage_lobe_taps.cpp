@@ -28,7 +28,6 @@ namespace {
 
 constexpr std::uint32_t taps_channels = 8;
 constexpr std::uint32_t check_nodes = 32; ///< nodes^2 lobe points of the midpoint check's L1 distances
-constexpr std::uint32_t cell_stride = 2;  ///< midpoint check: every second cell per axis
 
 /// The fit of every texel: two taps, 32^2 lobe points, 150 Nelder-Mead iterations per parameter.
 ibl::lobe_fit_options fit_options() {
@@ -117,15 +116,7 @@ std::array<ibl::lobe_tap, ibl::lobe_max_taps> taps_of(const std::array<float, ta
 void lobe_taps_stage::check_midpoints(pool_executor& ex) {
     const std::uint32_t n = lut_->size;
     std::vector<std::array<double, 4>> pts; // n.v, r, L1 of the table's taps, of a direct fit
-    for (std::uint32_t j = 0; j + 1 < n; j += cell_stride)
-        for (std::uint32_t i = 0; i + 1 < n; i += cell_stride) {
-            const auto mid = [&](ibl::dfg_axis a, std::uint32_t k) {
-                return ibl::dfg_axis_value(a, 0.5 * (ibl::dfg_texel_coord<double>(k, n, layout_.edge_aligned) +
-                                                     ibl::dfg_texel_coord<double>(k + 1, n, layout_.edge_aligned)));
-            };
-            const double nv = mid(layout_.n_dot_v, i), r = mid(layout_.roughness, j);
-            if (r >= 0.05 && nv >= 1e-3) pts.push_back({nv, r, 0.0, 0.0}); // as the fit's statistics
-        }
+    for (const auto& m : fit_check_midpoints(n, layout_)) pts.push_back({m[0], m[1], 0.0, 0.0});
     product_view pv;
     pv.taps = lut_;
     pv.dfg_layout = layout_;

@@ -187,6 +187,11 @@ void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level
 std::string c_table_header(const std::string& name, const std::string& what, std::uint32_t size, std::uint32_t channels,
                            const std::string& channel_list, const std::string& layout, const std::vector<float>& data);
 
+/// The (n.v, r) where the fitted tables' checks compare a bilinear read with a direct fit: the
+/// midpoints of every second cell per axis of a size^2 table in `layout`, those with r >= 0.05
+/// and n.v >= 1e-3 (as the fit's own statistics: no lobe at n.v = 0, near-mirror rows below).
+std::vector<std::array<double, 2>> fit_check_midpoints(std::uint32_t size, const ibl::dfg_lut_layout& layout);
+
 /// Max |A - A_dfg|, |B - B_dfg| of a table in a DFG layout whose channels 0, 1 are (A, B), against
 /// the DFG table read by ibl::dfg_lookup at the table's texels.
 double ab_vs_dfg(const std::vector<float>& data, std::uint32_t size, std::uint32_t channels, const ibl::dfg_lut_layout& layout,
