@@ -50,9 +50,7 @@
 #include <ibl/integrate/reference.hpp>
 #include <ibl/runtime.hpp>
 
-#if defined(IBL_EXAMPLES_DATA_DIR)
-#include "image_io.hpp"
-#endif
+#include "study_envs.hpp"
 
 namespace {
 
@@ -308,27 +306,6 @@ std::vector<variant> make_variants(bool explore) {
     return v;
 }
 
-// ---- deterministic points ------------------------------------------------------------------------
-
-std::uint32_t hash32(std::uint32_t x) {
-    x ^= x >> 16;
-    x *= 0x7feb352du;
-    x ^= x >> 15;
-    x *= 0x846ca68bu;
-    x ^= x >> 16;
-    return x;
-}
-double unit(std::uint32_t a, std::uint32_t b) { return double(hash32(hash32(a * 0x9e3779b9u + 17u) ^ b) >> 8) * 0x1p-24; }
-
-/// Point k at view cosine mu: n uniform on the sphere, v at acos(mu) from n with uniform azimuth.
-void make_point(std::uint32_t k, double mu, d3& n, d3& v) {
-    const double z = 1.0 - 2.0 * unit(k, 1), ph = 2.0 * M_PI * unit(k, 2), s = std::sqrt(std::max(0.0, 1.0 - z * z));
-    n = d3(s * std::cos(ph), z, s * std::sin(ph));
-    const ibl::frame<double> fr = ibl::make_frame(n);
-    const double az = 2.0 * M_PI * unit(k, 3), st = std::sqrt(std::max(0.0, (1.0 - mu) * (1.0 + mu)));
-    v = fr.to_world(d3(st * std::cos(az), st * std::sin(az), mu));
-}
-
 // ---- measurement ------------------------------------------------------------------------------
 
 /// Squared relative errors and reference variances summed per (material, variant, r, mu).
@@ -368,7 +345,7 @@ cell_sums measure(const Env& env, const ibl::cube_env_distribution& dist, const 
             ibl::thread_executor{2}(points, [&](std::size_t b, std::size_t e) {
                 for (std::size_t k = b; k < e; ++k) {
                     d3 n, v;
-                    make_point(std::uint32_t(k + 1000 * im), k_n_dot_v[im], n, v);
+                    study::make_point(std::uint32_t(k + 1000 * im), k_n_dot_v[im], n, v);
                     for (int m = 0; m < 2; ++m) {
                         ibl::reference_material rm;
                         rm.diffuse_albedo = d3(0.0);
@@ -528,29 +505,7 @@ int main(int argc, char** argv) {
         std::printf("%s: measured %.1f s\n", name.c_str(), seconds_since(t1));
         std::fflush(stdout);
     };
-    {
-        const ibl::sky_environment<double> sky = ibl::make_default_sky<double>();
-        const ibl::cubemap<float> src = ibl::bake_cubemap<float>(sky, 512, 4, ibl::thread_executor{2});
-        const ibl::cube_env_distribution dist = ibl::make_cube_env_distribution<double>(sky, 128, 4);
-        run("sky + sun", sky, src, dist);
-    }
-#if defined(IBL_EXAMPLES_DATA_DIR)
-    for (const char* file : {"courtyard.exr", "studio.exr"}) {
-        const std::string path = std::string(IBL_EXAMPLES_DATA_DIR) + "/" + file;
-        try {
-            const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(path, {});
-            ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);
-            map.update_borders();
-            const ibl::cubemap<float> src = ibl::bake_cubemap<float>(map, 512, 2, ibl::thread_executor{2});
-            const ibl::cube_env_distribution dist = ibl::make_cube_env_distribution<float>(map, 256, 2);
-            run(file, map, src, dist);
-        } catch (const std::exception& ex) {
-            std::printf("%s skipped: %s\n", file, ex.what());
-        }
-    }
-#else
-    (void)argv;
-#endif
+    study::for_each_environment(run);
 
     for (const env_result& e : results) print_env(e, vars);
 
