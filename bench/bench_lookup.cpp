@@ -31,7 +31,7 @@ using d3 = ibl::vec3<double>;
 
 const ibl::specular_lookup_desc& scheme(int k) {
     static const ibl::specular_lookup_desc s[3] = {
-        ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc{},
+        ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc::accurate(),
         {ibl::roughness_mapping::linear, ibl::level_weight::lod, 1.0, ibl::level_interpolation::catmull_rom}};
     return s[k];
 }
@@ -92,17 +92,17 @@ void BM_specular_lookup(benchmark::State& state) {
 BENCHMARK(BM_specular_lookup)->DenseRange(0, 2)->Unit(benchmark::kNanosecond);
 
 void BM_dfg_lookup(benchmark::State& state) {
-    const ibl::dfg_lut_layout lay = state.range(0) == 0 ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout{};
+    const ibl::dfg_lut_layout lay = state.range(0) == 0 ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout::remapped();
     const ibl::dfg_lut lut = ibl::make_dfg_lut_exact<ibl::ggx_height_correlated>(128, lay, 2);
     static const ibl::dfg_error_grid g = ibl::dfg_error_grid::dense(129, 96, 0.05);
     static const std::vector<ibl::vec2<double>> exact = ibl::dfg_exact_grid<ibl::ggx_height_correlated>(g);
-    const double err = ibl::dfg_lookup_error(lut, lay, g, exact).max_abs;
+    const double err = ibl::dfg_lookup_error(lut, g, exact).max_abs;
     std::vector<ibl::vec2<float>> p(1024);
     for (std::uint32_t i = 0; i < 1024; ++i) p[i] = ibl::vec2<float>(ibl::hammersley<double>(i, 1024));
     std::size_t i = 0;
     for (auto _ : state) {
         const ibl::vec2<float>& q = p[i & 1023];
-        benchmark::DoNotOptimize(ibl::dfg_lookup(lut, q.x, q.y, lay));
+        benchmark::DoNotOptimize(ibl::dfg_lookup(lut, q.x, q.y));
         ++i;
     }
     state.SetItemsProcessed(std::int64_t(state.iterations()));

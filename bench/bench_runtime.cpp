@@ -88,11 +88,11 @@ const fixture& fix() {
         const ibl::cubemap<float> src = ibl::bake_cubemap<float>(sky, 256, 4, ibl::thread_executor{});
         x.chain_nl = chain(src, ibl::ld_weight::n_dot_l);
         x.chain_g1 = chain(src, ibl::ld_weight::g1);
-        x.dfg = ibl::make_dfg_lut_exact<model>(128, ibl::dfg_lut_layout{}, 2);
-        x.lobe = ibl::make_lobe_lut<model>(64, ibl::dfg_lut_layout{}, ibl::ld_weight::g1);
-        x.lobe_fitted = ibl::make_lobe_lut_fitted<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1);
-        x.taps2 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, multi_tap_options(2));
-        x.taps3 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, multi_tap_options(3));
+        x.dfg = ibl::make_dfg_lut_exact<model>(128, ibl::dfg_lut_layout::remapped(), 2);
+        x.lobe = ibl::make_lobe_lut<model>(64, ibl::dfg_lut_layout::remapped(), ibl::ld_weight::g1);
+        x.lobe_fitted = ibl::make_lobe_lut_fitted<model>(32, ibl::dfg_lut_layout::remapped(), ibl::ld_weight::g1);
+        x.taps2 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout::remapped(), ibl::ld_weight::g1, multi_tap_options(2));
+        x.taps3 = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout::remapped(), ibl::ld_weight::g1, multi_tap_options(3));
         const ibl::cube_env_distribution dist = ibl::make_cube_env_distribution<double>(sky, 64, 4);
         std::uint32_t k = 0;
         for (double r : {0.3, 0.5, 0.8})
@@ -124,23 +124,22 @@ f3 evaluate(int variant, const fixture& f, const point& p) {
     const f3 r_dir = 2.0f * glm::dot(p.n, p.v) * p.n - p.v;
     const f3 albedo = ibl::split_sum_albedo(k_f0, f3(1.0f), ab);
     switch (variant) {
-    case 0: return ibl::specular_lookup(f.chain_nl, r_dir, p.roughness) * albedo;
-    case 1: return ibl::specular_lookup(f.chain_g1, r_dir, p.roughness) * albedo;
+    case 0: return ibl::specular_lookup(f.chain_nl, r_dir, p.roughness, ibl::specular_lookup_desc::accurate()) * albedo;
+    case 1: return ibl::specular_lookup(f.chain_g1, r_dir, p.roughness, ibl::specular_lookup_desc::accurate()) * albedo;
     case 2:
         return ibl::specular_lookup(f.chain_nl,
                                     ibl::lerp_direction(p.n, r_dir, ibl::dominant_lerp_frostbite(p.roughness)),
-                                    p.roughness) *
+                                    p.roughness, ibl::specular_lookup_desc::accurate()) *
                albedo;
     case 3:
-        return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc{}, f.lobe, ibl::dfg_lut_layout{}, p.n, p.v,
+        return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc::accurate(), f.lobe, p.n, p.v,
                                   p.roughness, k_f0, f3(1.0f));
     case 7:
-        return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc{}, f.lobe_fitted, ibl::dfg_lut_layout{}, p.n, p.v,
+        return ibl::specular_lobe(f.chain_g1, ibl::specular_lookup_desc::accurate(), f.lobe_fitted, p.n, p.v,
                                   p.roughness, k_f0, f3(1.0f));
     case 8:
     case 9:
-        return ibl::specular_lobe_taps(f.chain_g1, ibl::specular_lookup_desc{}, variant == 8 ? f.taps2 : f.taps3,
-                                       ibl::dfg_lut_layout{}, p.n, p.v, p.roughness, k_f0, f3(1.0f));
+        return ibl::specular_lobe_taps(f.chain_g1, ibl::specular_lookup_desc::accurate(), variant == 8 ? f.taps2 : f.taps3, p.n, p.v, p.roughness, k_f0, f3(1.0f));
     default: {
         ibl::runtime_fis_desc d;
         d.taps = variant == 4 ? 8 : (variant == 5 ? 16 : 64);
@@ -174,7 +173,7 @@ void BM_lobe_fit_table(benchmark::State& state) {
     const ibl::lobe_fit_options o = taps == 1 ? ibl::lobe_fit_options{} : multi_tap_options(taps);
     double l1 = 0.0;
     for (auto _ : state) {
-        const ibl::lobe_taps_lut l = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout{}, ibl::ld_weight::g1, o,
+        const ibl::lobe_taps_lut l = ibl::make_lobe_taps_lut<model>(32, ibl::dfg_lut_layout::remapped(), ibl::ld_weight::g1, o,
                                                                     ibl::thread_executor{2});
         benchmark::DoNotOptimize(l.data.data());
         l1 = l.mean_l1;

@@ -86,11 +86,11 @@ void run_dfg() {
     for (const std::uint32_t size : {32u, 64u, 128u, 256u}) {
         for (const auto& lay : layouts) {
             const ibl::dfg_lut lut = ibl::make_dfg_lut_exact<model>(size, lay, 2);
-            const ibl::dfg_lookup_report e = ibl::dfg_lookup_error(lut, lay, grid, exact);
-            const ibl::dfg_lookup_report eg = ibl::dfg_lookup_error(lut, lay, graze, exact_graze);
-            const ibl::dfg_lookup_report er = ibl::dfg_lookup_error(lut, lay, rest, exact_rest);
+            const ibl::dfg_lookup_report e = ibl::dfg_lookup_error(lut, grid, exact);
+            const ibl::dfg_lookup_report eg = ibl::dfg_lookup_error(lut, graze, exact_graze);
+            const ibl::dfg_lookup_report er = ibl::dfg_lookup_error(lut, rest, exact_rest);
             const ibl::dfg_lut lut_h = ibl::quantize_half_lut(lut);
-            const ibl::dfg_lookup_report eh = ibl::dfg_lookup_error(lut_h, lay, grid, exact);
+            const ibl::dfg_lookup_report eh = ibl::dfg_lookup_error(lut_h, grid, exact);
             std::printf("| %u | %s | %s | %s | %u | %.2e | (%.4f, %.3f) | %.2e | %.2e | %.1e | %.2e |\n", size,
                         axis_name(lay.n_dot_v), axis_name(lay.roughness), lay.edge_aligned ? "edge" : "sampler", size * size * 4u, e.max_abs,
                         e.worst_n_dot_v, e.worst_roughness, eg.max_abs, er.max_abs, e.rms, eh.max_abs);
@@ -110,7 +110,7 @@ struct chain_config {
 
 struct scheme {
     const char* name;
-    ibl::specular_lookup_desc desc; // mapping is overwritten by the chain's
+    ibl::specular_lookup_desc desc = ibl::specular_lookup_desc::accurate(); // mapping is overwritten by the chain's
 };
 
 std::vector<std::uint32_t> tool_samples(int levels) {

@@ -81,8 +81,8 @@ struct material_case {
 };
 const material_case k_materials[2] = {{"metal", d3(0.95, 0.64, 0.54)}, {"dielectric", d3(0.04)}};
 
-const ibl::dfg_lut_layout k_layout{};
-const ibl::specular_lookup_desc k_lookup{};
+const ibl::dfg_lut_layout k_layout = ibl::dfg_lut_layout::remapped();
+const ibl::specular_lookup_desc k_lookup = ibl::specular_lookup_desc::accurate();
 
 struct products {
     ibl::cubemap<float> chain{1};
@@ -92,7 +92,7 @@ struct products {
 
 /// The unoccluded runtime specular: split sum with the G1 chain.
 f3 runtime_specular(const products& p, const f3& n, const f3& v, float n_dot_v, float r, const f3& f0) {
-    const f3 abk = ibl::dfg_lookup(*p.dfg, n_dot_v, r, k_layout);
+    const f3 abk = ibl::dfg_lookup(*p.dfg, n_dot_v, r);
     const f3 albedo = ibl::split_sum_albedo(f0, f3(1.0f), ibl::vec2<float>(abk.x, abk.y));
     const f3 rd = 2.0f * glm::dot(n, v) * n - v;
     return ibl::specular_lookup(p.chain, rd, r, k_lookup) * albedo;

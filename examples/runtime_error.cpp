@@ -100,11 +100,11 @@ struct variant {
     variant_fn fn;
 };
 
-const ibl::dfg_lut_layout k_layout{};
-const ibl::specular_lookup_desc k_lookup{}; // default two-tap lookup (lookup.hpp)
+const ibl::dfg_lut_layout k_layout = ibl::dfg_lut_layout::remapped();
+const ibl::specular_lookup_desc k_lookup = ibl::specular_lookup_desc::accurate(); // default two-tap lookup (lookup.hpp)
 
 f3 albedo_of(const products& p, const shading_point& s) {
-    const f3 abk = ibl::dfg_lookup(*p.dfg, s.n_dot_v, s.roughness, k_layout);
+    const f3 abk = ibl::dfg_lookup(*p.dfg, s.n_dot_v, s.roughness);
     return ibl::split_sum_albedo(s.f0, f3(1.0f), ibl::vec2<float>(abk.x, abk.y));
 }
 
@@ -120,7 +120,7 @@ f3 fis(const ibl::cubemap<float>& chain, const products& p, const shading_point&
     d.taps = taps;
     d.footprint_scale = scale;
     d.normalise = normalise;
-    const f3 abk = ibl::dfg_lookup(*p.dfg, s.n_dot_v, s.roughness, k_layout);
+    const f3 abk = ibl::dfg_lookup(*p.dfg, s.n_dot_v, s.roughness);
     return ibl::specular_fis(chain, d, s.n, s.v, s.roughness, s.f0, f3(1.0f), ibl::vec2<float>(abk.x, abk.y));
 }
 
@@ -189,15 +189,15 @@ f3 mixture(const ibl::cubemap<float>& chain, const products& p, const shading_po
 /// The fitted tables (G1 chain): one tap (the lobe LUT format), 2 and 3 taps.
 void add_fitted_table_variants(std::vector<variant>& v) {
     v.push_back({"fitted lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_fit_g1, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
     v.push_back({"fitted 2 taps LUT, G1", "4 + 2", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps2_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps2_g1, s.n, s.v, s.roughness, s.f0,
                                                     f3(1.0f));
                  }});
     v.push_back({"fitted 3 taps LUT, G1", "6 + 3", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe_taps(p.chain_g1, k_lookup, *p.taps3_g1, s.n, s.v, s.roughness, s.f0,
                                                     f3(1.0f));
                  }});
 }
@@ -208,7 +208,7 @@ std::vector<variant> make_fit_variants() {
                      return split(p.chain_g1, p, s, reflect_dir(s));
                  }});
     v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
     add_fitted_table_variants(v);
@@ -261,15 +261,15 @@ std::vector<variant> make_variants(bool explore) {
                                   ibl::lerp_direction(s.n, reflect_dir(s), ibl::dominant_lerp_frostbite(s.roughness)));
                  }});
     v.push_back({"lobe LUT, n.l", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_nl, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_nl, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
     v.push_back({"lobe LUT, G1", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe(p.chain_g1, k_lookup, *p.lobe_g1, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
     v.push_back({"fitted lobe LUT, n.l", "2 + 1", [](const products& p, const shading_point& s) {
-                     return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_fit_nl, k_layout, s.n, s.v, s.roughness, s.f0,
+                     return ibl::specular_lobe(p.chain_nl, k_lookup, *p.lobe_fit_nl, s.n, s.v, s.roughness, s.f0,
                                                f3(1.0f));
                  }});
     add_fitted_table_variants(v);

@@ -1,8 +1,17 @@
 #!/usr/bin/env bash
-# Installs (as root, with apt-get) the Debian packages that the build, tests, benchmarks and
-# tools need, skipping those already present.
+# Installs (as root, with apt-get) the Debian packages a job needs, skipping those already present.
+#   bash scripts/deps.sh bake   what the main job needs: build and run ibl-bake (compiler, CMake,
+#                               Ninja, GLM, stb, OpenEXR)
+#   bash scripts/deps.sh        everything the tests, benchmarks and tools need (the test command):
+#                               also clang, doctest, Google Benchmark, matplotlib, glslang, chromium
 set -euo pipefail
-pkgs=(cmake ninja-build g++ clang libclang-rt-14-dev libglm-dev doctest-dev libbenchmark-dev libstb-dev libopenexr-dev python3-matplotlib glslang-tools chromium)
+bake=(cmake ninja-build g++ libglm-dev libstb-dev libopenexr-dev)
+all=("${bake[@]}" clang libclang-rt-14-dev doctest-dev libbenchmark-dev python3-matplotlib glslang-tools chromium)
+case "${1:-all}" in
+    bake) pkgs=("${bake[@]}") ;;
+    all) pkgs=("${all[@]}") ;;
+    *) echo "usage: deps.sh [bake|all]" >&2; exit 2 ;;
+esac
 missing=()
 for p in "${pkgs[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

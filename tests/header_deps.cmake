@@ -11,9 +11,9 @@
 #   ibl/sh.hpp        core/ sh/ env/cube_geometry.hpp   (no integrate/, batch/: no prefilter code)
 #   ibl/shade.hpp     core/ brdf/                       (takes products as values, bakes nothing)
 #   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
-#   ibl/lookup.hpp    core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp (runtime lookups: no
+#   ibl/lookup.hpp    core/ brdf/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp (runtime lookups: no
 #                     integrator, no DFG table code; tables are read through their members)
-#   ibl/runtime.hpp   core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp shade.hpp lookup.hpp
+#   ibl/runtime.hpp   core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp lookup.hpp
 #                     (runtime approximations: reads the chain and tables, bakes nothing)
 #   ibl/batch.hpp     core/ brdf/ sampling/ env/ batch/ (kernels; never integrate/, which calls them)
 #   ibl/batch/**.hpp  the same, for every header under batch/ (also one the umbrella leaves out)
@@ -31,8 +31,8 @@ set(rules
     "sh.hpp|core/ sh/ env/cube_geometry.hpp"
     "shade.hpp|core/ brdf/"
     "plan.hpp|core/ integrate/roughness_mip.hpp"
-    "lookup.hpp|core/ brdf/ env/ integrate/roughness_mip.hpp shade.hpp"
-    "runtime.hpp|core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp shade.hpp lookup.hpp"
+    "lookup.hpp|core/ brdf/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp"
+    "runtime.hpp|core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp lookup.hpp"
     "batch.hpp|core/ brdf/ sampling/ env/ batch/"
     "batch/*.hpp|core/ brdf/ sampling/ env/ batch/")
 

@@ -23,7 +23,7 @@ constexpr double feps = std::numeric_limits<float>::epsilon();
 
 const ibl::specular_lookup_desc k_schemes[] = {
     ibl::specular_lookup_desc::textbook(),
-    ibl::specular_lookup_desc{},
+    ibl::specular_lookup_desc::accurate(),
     {ibl::roughness_mapping::linear, ibl::level_weight::power, 3.0, ibl::level_interpolation::linear},
     {ibl::roughness_mapping::linear, ibl::level_weight::log, 1.0, ibl::level_interpolation::linear},
     {ibl::roughness_mapping::linear, ibl::level_weight::log, 1.0, ibl::level_interpolation::geometric},
@@ -133,14 +133,15 @@ TEST_CASE("dfg layout: remap inverse, texel centres return the texel, uniform = 
             lut.data[(j * n + i) * 2] = float(i) / n;
             lut.data[(j * n + i) * 2 + 1] = float(j) / n + float(i) / (n * n);
         }
-    const ibl::dfg_lut_layout layouts[] = {ibl::dfg_lut_layout::uniform(), ibl::dfg_lut_layout{},
+    const ibl::dfg_lut_layout layouts[] = {ibl::dfg_lut_layout::uniform(), ibl::dfg_lut_layout::remapped(),
                                            {ibl::dfg_axis::sqrt, ibl::dfg_axis::linear, false}};
     for (const auto& lay : layouts)
         for (std::uint32_t j = 0; j < n; ++j)
             for (std::uint32_t i = 0; i < n; ++i) {
+                lut.layout = lay; // the lookup reads the table's own layout
                 const float mu = ibl::dfg_texel_value<float>(lay.n_dot_v, i, n, lay.edge_aligned);
                 const float r = ibl::dfg_texel_value<float>(lay.roughness, j, n, lay.edge_aligned);
-                const ibl::vec3<float> v = ibl::dfg_lookup(lut, mu, r, lay);
+                const ibl::vec3<float> v = ibl::dfg_lookup(lut, mu, r);
                 CHECK(double(v.x) == doctest::Approx(lut.at(i, j, 0)).scale(1).epsilon(8 * n * feps));
                 CHECK(double(v.y) == doctest::Approx(lut.at(i, j, 1)).scale(1).epsilon(8 * n * feps));
             }
@@ -151,29 +152,68 @@ TEST_CASE("dfg layout: remap inverse, texel centres return the texel, uniform = 
     CHECK(a.data == b.data);
     for (int k = 0; k <= 10; ++k) {
         const float mu = 0.1f * float(k), r = 1.0f - 0.1f * float(k);
-        const ibl::vec3<float> x = a.sample(mu, r), y = ibl::dfg_lookup(b, mu, r, ibl::dfg_lut_layout::uniform());
+        const ibl::vec3<float> x = a.sample(mu, r), y = ibl::dfg_lookup(b, mu, r);
         CHECK(x.x == y.x);
         CHECK(x.y == y.y);
         CHECK(x.z == y.z);
     }
 }
 
-TEST_CASE("dfg lookup: the default layout at 128^2 meets 1e-3 for r >= 0.05 (the uniform table does not)") {
+TEST_CASE("dfg lookup: the remapped layout at 128^2 meets 1e-3 for r >= 0.05 (the uniform table does not)") {
     // Grid: n.v uniform and quadratic at 97 points each (both ends), r in [0.05, 1] at 40 points;
     // exact values by the converged quadrature (1e-6). The measured errors (examples/lookup_error):
     // default 5.7e-4 (f32), 5.5e-4 (f16); uniform 8.5e-2 at n.v = 0 (its half-texel clamp).
     const ibl::dfg_error_grid g = ibl::dfg_error_grid::dense(97, 40, 0.05);
     const std::vector<ibl::vec2<double>> exact = ibl::dfg_exact_grid<ibl::ggx_height_correlated>(g);
-    const ibl::dfg_lut_layout lay{};
+    const ibl::dfg_lut_layout lay = ibl::dfg_lut_layout::remapped();
     const ibl::dfg_lut lut = ibl::make_dfg_lut_exact<ibl::ggx_height_correlated>(128, lay, 2);
-    const ibl::dfg_lookup_report e = ibl::dfg_lookup_error(lut, lay, g, exact);
+    const ibl::dfg_lookup_report e = ibl::dfg_lookup_error(lut, g, exact);
     CHECK(e.count == exact.size());
     CHECK(e.max_abs <= 1e-3);
-    const ibl::dfg_lookup_report eh = ibl::dfg_lookup_error(ibl::quantize_half_lut(lut), lay, g, exact);
+    const ibl::dfg_lookup_report eh = ibl::dfg_lookup_error(ibl::quantize_half_lut(lut), g, exact);
     // Half rounding adds at most half an ulp of values <= 1 (2^-12) to each texel.
     CHECK(eh.max_abs <= e.max_abs + std::ldexp(1.0, -12));
     const ibl::dfg_lut uni = ibl::make_dfg_lut_exact<ibl::ggx_height_correlated>(128, 2);
-    CHECK(ibl::dfg_lookup_error(uni, ibl::dfg_lut_layout::uniform(), g, exact).max_abs > 2e-3);
+    CHECK(ibl::dfg_lookup_error(uni, g, exact).max_abs > 2e-3);
+}
+
+template <class Table>
+concept lookup_names_layout = requires(const Table& t) { ibl::dfg_lookup(t, 0.5f, 0.5f, ibl::dfg_lut_layout::remapped()); };
+template <class Table> concept lookup_reads_table = requires(const Table& t) { ibl::dfg_lookup(t, 0.5f, 0.5f); };
+
+TEST_CASE("dfg table: built with the defaults, read with the default lookup, it answers its own integrand") {
+    // The trap this guards: a table built in one layout and read as another gave (0.688, 0.0014)
+    // at (n.v, r) = (0.5, 0.5) where the integrand is (0.835, 0.0223), with no error. Every table
+    // now records its layout and every lookup reads it from the table.
+    using M = ibl::ggx_height_correlated;
+    const ibl::vec2<double> exact = ibl::dfg_exact<M>(0.5, 0.5);
+    for (const ibl::dfg_lut& lut : {ibl::make_dfg_lut_exact<M>(32), ibl::make_dfg_lut_exact<M>(32, ibl::dfg_lut_layout::remapped()),
+                                    ibl::make_dfg_lut_mc<M>(32, 4096)}) {
+        CAPTURE(lut.layout.name());
+        CHECK(lut.model == "ggx_height_correlated");
+        const ibl::vec3<float> v = ibl::dfg_lookup(lut, 0.5f, 0.5f);
+        CHECK(double(v.x) == doctest::Approx(exact.x).scale(1).epsilon(3e-3));
+        CHECK(double(v.y) == doctest::Approx(exact.y).scale(1).epsilon(1e-3));
+        const ibl::vec3<float> w = lut.sample(0.5f, 0.5f); // the table's own read: the same
+        CHECK(w.x == v.x);
+        CHECK(w.y == v.y);
+    }
+    // The defaults are the textbook table, read by texture(lut, vec2(n.v, r)).
+    CHECK(ibl::make_dfg_lut_exact<M>(8).layout == ibl::dfg_lut_layout::uniform());
+    CHECK(ibl::dfg_lut_layout{} == ibl::dfg_lut_layout::uniform());
+    CHECK(ibl::dfg_lut_coord(0.3f, 0.7f, 32u, ibl::dfg_lut{}.layout) == ibl::vec2<float>(0.3f, 0.7f));
+    // A lookup that names another layout than the table's does not compile (it takes none).
+    static_assert(!lookup_names_layout<ibl::dfg_lut>);
+    static_assert(lookup_reads_table<ibl::dfg_lut>);
+    // Layout names round-trip (what files record).
+    for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b)
+            for (bool e : {false, true}) {
+                const ibl::dfg_lut_layout l{ibl::dfg_axis(a), ibl::dfg_axis(b), e};
+                CHECK(ibl::parse_dfg_lut_layout(l.name()) == l);
+            }
+    CHECK_THROWS_AS((void)ibl::parse_dfg_lut_layout("cbrt"), std::invalid_argument);
+    CHECK(ibl::dfg_lut_layout::remapped().name() == "remapped");
 }
 
 TEST_CASE("round_through_half: IEEE binary16 rounding") {
@@ -236,7 +276,7 @@ TEST_CASE("specular interpolation error on a smooth environment matches its clos
         return out;
     };
     const std::vector<double> rs = {0.25, 0.3, 0.5, 0.7, 0.9};
-    for (const auto& desc : {ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc{}}) {
+    for (const auto& desc : {ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc::accurate()}) {
         const auto rep = ibl::specular_lookup_error(chain, desc, rs, dirs, ref);
         REQUIRE(rep.size() == rs.size());
         for (const auto& x : rep) {

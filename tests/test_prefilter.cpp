@@ -428,7 +428,7 @@ TEST_CASE("prefilter: sample counts 0, 1 and 2^20; 1x1 faces; bad input") {
     }
     SUBCASE("invalid options throw") {
         ibl::prefilter_options o;
-        o.levels = -1;
+        o.levels = -2; // -1 is prefilter_options::automatic
         CHECK_THROWS_AS((void)ibl::prefilter(constant_cube(2, c), o), std::invalid_argument);
         CHECK_THROWS_AS((void)ibl::prefilter(ibl::constant_environment<float>{c}), std::invalid_argument);
     }

@@ -10,6 +10,7 @@
 #include "integrate.hpp"
 #include "lookup.hpp"
 #include "plan.hpp"
+#include "runtime.hpp"
 #include "sampling.hpp"
 #include "shade.hpp"
 #include "sh.hpp"

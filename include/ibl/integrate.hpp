@@ -3,6 +3,7 @@
 #include "integrate/dfg.hpp"
 #include "integrate/dfg_export.hpp"
 #include "integrate/dfg_fit.hpp"
+#include "integrate/dfg_layout.hpp"
 #include "integrate/dfg_lut.hpp"
 #include "integrate/dfg_multiscatter.hpp"
 #include "integrate/disk_light.hpp"

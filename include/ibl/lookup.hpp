@@ -31,30 +31,16 @@
 //                                     per channel.
 //   level_interpolation::geometric    L_l^(1 - t) L_{l+1}^t per channel (linear where either is
 //                                     <= 0): two taps at integer lods. With level_weight::log it
-//                                     is exact where LD is a power law in r (the default).
+//                                     is exact where LD is a power law in r (specular_lookup_desc::accurate()).
 // Both reproduce a level exactly at its own roughness (t = 0 gives weight 1 on level l, 0 on the
 // others; the interpolation is written so that the weights are exactly 1 and 0 there), and both
 // reproduce a constant environment exactly (the weights sum to 1).
 //
-// ---- DFG: the table's parameterisation ---------------------------------------------------------
-// A table of N x N texels (integrate/dfg_lut.hpp's storage: row j, column i, channels interleaved)
-// whose texel (i, j) holds the DFG value at n.v = x(c_i), roughness = y(c_j), where c_i is the
-// axis coordinate of texel i's centre and x, y are the axis maps of a dfg_lut_layout:
-//   centres    edge aligned  c_i = i / (N - 1)   (first and last centres on 0 and 1: nothing is
-//                                                clamped; the shader remaps s = (c (N-1) + 0.5)/N)
-//              sampler       c_i = (i + 0.5) / N (a GPU sampler's centres, s = c: the half texel
-//                                                at each end is clamped to the edge texel)
-//   axis map   dfg_axis::linear  value = c       (the textbook table: n.v, r)
-//              dfg_axis::sqrt    value = c^2     (c = sqrt(value): texels crowd near 0)
-//              dfg_axis::cbrt    value = c^3     (c = cbrt(value): more so)
-//   Why: at low roughness the DFG terms change over a range of n.v ~ alpha = r^2 next to grazing
-//   (the masking of a nearly smooth surface), and over a range of r ~ sqrt(n.v) there; a uniform
-//   axis puts under one texel of n.v in that range at r = 0.05 on a 128 table.
-// A shader samples the table with clamp-to-edge and bilinear filtering at
-// (s, t) = dfg_lut_coord(n.v, r, N, layout); for the textbook layout (linear axes, sampler
-// centres: dfg_lut_layout::uniform(), integrate/dfg_lut.hpp's make_dfg_lut_exact and sample) that
-// is texture(lut, vec2(n.v, r)).
-// Tables of other layouts: make_dfg_lut_exact(size, layout, ...) in integrate/lookup_error.hpp.
+// ---- DFG ----------------------------------------------------------------------------------------
+// The table's layout (integrate/dfg_layout.hpp) is part of the table: dfg_lookup reads it from the
+// table (member `layout`), so a table is never read in another layout than its own. The default
+// (textbook) layout is read by texture(lut, vec2(n.v, r)); dfg_lut_layout::remapped() tables by
+// texture(lut, dfg_lut_coord(n.v, r, N, layout)).
 //
 // ---- Shading -------------------------------------------------------------------------------------
 // ibl_lookup_sample() gathers an ibl_sample (shade.hpp) from a chain and a table at a shading
@@ -74,6 +60,7 @@
 #include "core/math.hpp"
 #include "core/vec.hpp"
 #include "env/cubemap.hpp"
+#include "integrate/dfg_layout.hpp"
 #include "integrate/roughness_mip.hpp"
 #include "shade.hpp"
 
@@ -94,19 +81,31 @@ enum class level_interpolation : int {
 };
 
 /// How a renderer reads the specular chain at a roughness (see the header). The default is the
-/// best two-tap scheme measured (docs/lookup.md): t linear in log r, geometric blend (per channel
-/// L_l^(1 - t) L_{l+1}^t), which is exact wherever LD follows a power law in r: in a bright
-/// source's GGX tail (LD ~ alpha^2 = r^4) and at its peak (LD ~ 1 / alpha^2 = r^-4). GPU cost:
-/// two textureLod at integer lods, one log per lookup for t, one exp2/log2 pair per channel.
+/// textbook lookup, textureLod(chain, R, lod(r)) under the bake's mapping (one trilinear tap).
+/// accurate() is the best two-tap scheme measured (docs/lookup.md): t linear in log r, geometric
+/// blend (per channel L_l^(1 - t) L_{l+1}^t), which is exact wherever LD follows a power law in r:
+/// in a bright source's GGX tail (LD ~ alpha^2 = r^4) and at its peak (LD ~ 1 / alpha^2 = r^-4).
+/// GPU cost: two textureLod at integer lods, one log per lookup for t, one exp2/log2 pair per
+/// channel.
 struct specular_lookup_desc {
     roughness_mapping mapping = roughness_mapping::linear; ///< what the bake stored per level
-    level_weight weight = level_weight::log;
-    double weight_exponent = 2.0; ///< p of level_weight::power (unused by the others)
-    level_interpolation interpolation = level_interpolation::geometric;
+    level_weight weight = level_weight::lod;
+    double weight_exponent = 1.0; ///< p of level_weight::power (unused by the others)
+    level_interpolation interpolation = level_interpolation::linear;
 
-    /// The textbook lookup: textureLod(chain, R, lod(r)) under the bake's mapping.
+    /// The textbook lookup (the default): textureLod(chain, R, lod(r)) under the bake's mapping.
     static constexpr specular_lookup_desc textbook(roughness_mapping m = roughness_mapping::linear) noexcept {
         return {m, level_weight::lod, 1.0, level_interpolation::linear};
+    }
+    /// The accurate two-tap lookup: t linear in log r, geometric blend.
+    static constexpr specular_lookup_desc accurate(roughness_mapping m = roughness_mapping::linear) noexcept {
+        return {m, level_weight::log, 2.0, level_interpolation::geometric};
+    }
+    /// "textbook", "accurate", or a description of another combination (what files record).
+    const char* name() const noexcept {
+        if (weight == level_weight::lod && interpolation == level_interpolation::linear) return "textbook";
+        if (weight == level_weight::log && interpolation == level_interpolation::geometric) return "accurate";
+        return "custom";
     }
 };
 
@@ -218,104 +217,10 @@ inline vec3<float> specular_lookup(const cubemap<float>& chain, const vec3<float
     return specular_blend(s, v, d);
 }
 
-// ---- DFG -----------------------------------------------------------------------------------------
-
-enum class dfg_axis : int {
-    linear = 0, ///< texel coordinate = value
-    sqrt = 1,   ///< texel coordinate = sqrt(value)
-    cbrt = 2,   ///< texel coordinate = cbrt(value)
-};
-
-/// Parameterisation of a DFG table (see the header). The default is the layout chosen from the
-/// measurements of docs/lookup.md; dfg_lut_layout::uniform() is integrate/dfg_lut.hpp's.
-struct dfg_lut_layout {
-    dfg_axis n_dot_v = dfg_axis::cbrt;
-    dfg_axis roughness = dfg_axis::sqrt;
-    /// true: the first and last texel centres sit on axis coordinates 0 and 1 (c_i = i / (N - 1));
-    /// false: a sampler's centres c_i = (i + 0.5) / N, with the half texel at each end clamped.
-    bool edge_aligned = true;
-
-    static constexpr dfg_lut_layout uniform() noexcept { return {dfg_axis::linear, dfg_axis::linear, false}; }
-};
-
-/// The axis coordinate in [0, 1] of a value in [0, 1] (clamped, NaN -> 0).
-template <class T> IBL_FUNC T dfg_axis_coord(dfg_axis a, T value) noexcept {
-    using std::cbrt;
-    using std::sqrt;
-    const T v = saturate(value);
-    return a == dfg_axis::sqrt ? sqrt(v) : (a == dfg_axis::cbrt ? cbrt(v) : v);
-}
-
-/// The value at axis coordinate c (the inverse of dfg_axis_coord).
-template <class T> IBL_FUNC T dfg_axis_value(dfg_axis a, T coord) noexcept {
-    const T c = saturate(coord);
-    return a == dfg_axis::sqrt ? c * c : (a == dfg_axis::cbrt ? c * c * c : c);
-}
-
-/// The axis coordinate of the centre of texel i of an axis of `size` texels: i / (size - 1) when
-/// edge aligned (0.5 for a single texel), (i + 0.5) / size otherwise.
-template <class T> IBL_FUNC T dfg_texel_coord(std::uint32_t i, std::uint32_t size, bool edge_aligned) noexcept {
-    if (edge_aligned) return size > 1 ? T(i) / T(size - 1) : T(0.5);
-    return (T(i) + T(0.5)) / T(size);
-}
-
-/// The value held by texel i of an axis of `size` texels.
-template <class T>
-IBL_FUNC T dfg_texel_value(dfg_axis a, std::uint32_t i, std::uint32_t size, bool edge_aligned) noexcept {
-    return dfg_axis_value(a, dfg_texel_coord<T>(i, size, edge_aligned));
-}
-
-/// The sampler coordinate (GPU convention: texel i's centre at (i + 0.5) / size) of axis
-/// coordinate c: c itself, or c (size - 1) / size + 0.5 / size when edge aligned.
-template <class T> IBL_FUNC T dfg_sampler_coord(T c, std::uint32_t size, bool edge_aligned) noexcept {
-    if (!edge_aligned || size == 0) return c;
-    return (c * T(size - 1) + T(0.5)) / T(size);
-}
-
-/// Sampler coordinates (s, t) of (n.v, r) in a table of `size` texels per side and the layout:
-/// what a shader passes to texture(lut, st) with clamp-to-edge and bilinear filtering.
-template <class T>
-IBL_FUNC vec2<T> dfg_lut_coord(T n_dot_v, T roughness, std::uint32_t size, const dfg_lut_layout& layout = {}) noexcept {
-    return {dfg_sampler_coord(dfg_axis_coord(layout.n_dot_v, n_dot_v), size, layout.edge_aligned),
-            dfg_sampler_coord(dfg_axis_coord(layout.roughness, roughness), size, layout.edge_aligned)};
-}
-
-namespace detail {
-/// Bilinear read with clamp-to-edge at sampler coordinates (s, t) of a table with members size,
-/// channels and data (row-major, interleaved): channels 0 .. min(channels, count) - 1 into out
-/// (the others untouched). The one texel filter of every LUT lookup (DFG, sheen, lobe tables).
-template <class Table> void table_bilinear(const Table& lut, float s, float t, float* out, std::uint32_t count) {
-    const std::uint32_t n = lut.size;
-    if (n == 0) return;
-    const float fx = clamp(s * float(n) - 0.5f, 0.0f, float(n - 1));
-    const float fy = clamp(t * float(n) - 0.5f, 0.0f, float(n - 1));
-    const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
-    const std::uint32_t i1 = i0 + 1 < n ? i0 + 1 : i0, j1 = j0 + 1 < n ? j0 + 1 : j0;
-    const float tx = fx - float(i0), ty = fy - float(j0);
-    const std::uint32_t ch = lut.channels;
-    auto at = [&](std::uint32_t i, std::uint32_t j, std::uint32_t c) {
-        return float(lut.data[(std::size_t(j) * n + i) * ch + c]);
-    };
-    for (std::uint32_t c = 0; c < ch && c < count; ++c) {
-        const float top = lerp(at(i0, j0, c), at(i1, j0, c), tx);
-        const float bottom = lerp(at(i0, j1, c), at(i1, j1, c), tx);
-        out[c] = lerp(top, bottom, ty);
-    }
-}
-} // namespace detail
-
-/// Bilinear lookup with clamp-to-edge at sampler coordinates (s, t) of a table with members
-/// size, channels and data (dfg_lut): channels 0..2 (channel 2 is 0 for a two-channel table).
-template <class Table> vec3<float> dfg_sample_st(const Table& lut, float s, float t) {
-    float v[3] = {0.0f, 0.0f, 0.0f};
-    detail::table_bilinear(lut, s, t, v, 3);
-    return vec3<float>(v[0], v[1], v[2]);
-}
-
-/// The DFG table of a layout at (n.v, r): (A, B, k) by one bilinear tap at dfg_lut_coord.
-template <class Table>
-vec3<float> dfg_lookup(const Table& lut, float n_dot_v, float roughness, const dfg_lut_layout& layout = {}) {
-    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, layout);
+/// The DFG table at (n.v, r): (A, B, k) by one bilinear tap at dfg_lut_coord in the table's own
+/// layout (lut.layout).
+template <class Table> vec3<float> dfg_lookup(const Table& lut, float n_dot_v, float roughness) {
+    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, lut.layout);
     return dfg_sample_st(lut, st.x, st.y);
 }
 
@@ -326,13 +231,13 @@ vec3<float> dfg_lookup(const Table& lut, float n_dot_v, float roughness, const d
 /// irradiance_over_pi is passed through (E(n)/pi from SH or an irradiance map; 0 if not baked).
 template <class Table>
 ibl_sample<float> ibl_lookup_sample(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
-                                    const dfg_lut_layout& layout, const vec3<float>& n, const vec3<float>& v,
-                                    float roughness, const vec3<float>& irradiance_over_pi = vec3<float>(0.0f)) {
+                                    const vec3<float>& n, const vec3<float>& v, float roughness,
+                                    const vec3<float>& irradiance_over_pi = vec3<float>(0.0f)) {
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
     ibl_sample<float> s;
     s.ld = specular_lookup(chain, r_dir, roughness, sd);
-    const vec3<float> dfg = dfg_lookup(lut, n_dot_v, roughness, layout);
+    const vec3<float> dfg = dfg_lookup(lut, n_dot_v, roughness);
     s.dfg = vec2<float>(dfg.x, dfg.y);
     s.irradiance_over_pi = irradiance_over_pi;
     return s;

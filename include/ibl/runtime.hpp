@@ -219,24 +219,24 @@ inline vec3<float> specular_fis(const cubemap<float>& chain, const runtime_fis_d
 // ---- the lobe LUT ------------------------------------------------------------------------------
 
 /// Bilinear lookup with clamp-to-edge of channels 0..3 of a table with members size, channels and
-/// data (integrate/lobe_lut.hpp's lobe_lut) at the coordinates of a DFG layout (lookup.hpp).
-template <class Table>
-vec4<float> lobe_lut_lookup(const Table& lut, float n_dot_v, float roughness, const dfg_lut_layout& layout = {}) {
-    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, layout);
+/// data (integrate/lobe_lut.hpp's lobe_lut) at the coordinates of the table's own layout
+/// (member layout, integrate/dfg_layout.hpp).
+template <class Table> vec4<float> lobe_lut_lookup(const Table& lut, float n_dot_v, float roughness) {
+    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, lut.layout);
     float v[4] = {0.0f, 0.0f, 0.0f, 0.0f};
     detail::table_bilinear(lut, st.x, st.y, v, 4);
     return vec4<float>(v[0], v[1], v[2], v[3]);
 }
 
 /// The one-tap lobe model (header): LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) with
-/// (A, B, s, r_eff) = lobe_lut_lookup(lut, n.v, r, layout). sd: the chain's lookup.
+/// (A, B, s, r_eff) = lobe_lut_lookup(lut, n.v, r). sd: the chain's lookup.
 template <class Table>
 vec3<float> specular_lobe(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
-                          const dfg_lut_layout& layout, const vec3<float>& n, const vec3<float>& v, float roughness,
-                          const vec3<float>& f0, const vec3<float>& f90) {
+                          const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
+                          const vec3<float>& f90) {
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
-    const vec4<float> p = lobe_lut_lookup(lut, n_dot_v, roughness, layout);
+    const vec4<float> p = lobe_lut_lookup(lut, n_dot_v, roughness);
     const vec3<float> d = lerp_direction(n, r_dir, p.z);
     return specular_lookup(chain, d, p.w, sd) * split_sum_albedo(f0, f90, vec2<float>(p.x, p.y));
 }
@@ -269,12 +269,12 @@ template <class T> IBL_FUNC T lobe_tap_angle(T stored, T n_dot_v) noexcept {
 /// and ceil((2 + 3 taps) / 4) RGBA table reads.
 template <class Table>
 vec3<float> specular_lobe_taps(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
-                               const dfg_lut_layout& layout, const vec3<float>& n, const vec3<float>& v, float roughness,
-                               const vec3<float>& f0, const vec3<float>& f90) {
+                               const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
+                               const vec3<float>& f90) {
     constexpr std::uint32_t max_channels = 2 + 3 * 8;
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
-    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, layout);
+    const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, lut.layout);
     float p[max_channels] = {};
     detail::table_bilinear(lut, st.x, st.y, p, lut.channels < max_channels ? lut.channels : max_channels);
     const vec3<float> t = incidence_tangent(n, r_dir);

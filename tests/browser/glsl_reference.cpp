@@ -36,7 +36,7 @@ v3 dir_of(int i) {
     return glm::normalize(v3(a, 0.5f + 0.0625f * float(i % 5), b));
 }
 
-ibl::specular_lookup_desc desc_default() { return {}; }
+ibl::specular_lookup_desc desc_default() { return ibl::specular_lookup_desc::accurate(); }
 
 // ---- the runtime rows' fixtures (tools/viewer/numeric.frag.glsl: u_chain, u_taps_a, u_taps_b) ----
 
@@ -68,6 +68,7 @@ const ibl::cubemap<float>& fixture_chain() {
 /// (the fallback), weight 0 of tap 1 on row 0.
 struct taps_table {
     std::uint32_t size = 4, channels = 8;
+    ibl::dfg_lut_layout layout = ibl::dfg_lut_layout::remapped(); // the GLSL side reads it remapped
     int taps = 2;
     std::vector<float> data;
 };
@@ -95,7 +96,7 @@ const taps_table& fixture_taps() {
 }
 
 ibl::specular_lookup_desc chain_lookup(bool textbook) {
-    return textbook ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc{};
+    return textbook ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc::accurate();
 }
 
 /// The runtime rows' view and normal: n = dir_of(i), v = dir_of((7 i + 3) mod 64).
@@ -328,7 +329,7 @@ v4 taps_bound(int i, float r, const v3& f0, const v3& f90, bool textbook) {
     const v3 n = fis_n(i), v = fis_v(i);
     const float n_dot_v = ibl::saturate(glm::dot(n, v));
     const v3 r_dir = 2.0f * glm::dot(n, v) * n - v;
-    const auto st = ibl::dfg_lut_coord(n_dot_v, r, lut.size, ibl::dfg_lut_layout{});
+    const auto st = ibl::dfg_lut_coord(n_dot_v, r, lut.size, ibl::dfg_lut_layout::remapped());
     float p[8] = {};
     ibl::detail::table_bilinear(lut, st.x, st.y, p, 8);
     const v3 t = ibl::incidence_tangent(n, r_dir);
@@ -628,7 +629,7 @@ v4 runtime_row(int j, int i) {
         return {ibl::specular_fis(fixture_chain(), d, fis_n(i), fis_v(i), x, fis_f0(i), v3(1.0f), fis_dfg(i)), 0.0f};
     }
     if (j == 26)
-        return {ibl::specular_lobe_taps(fixture_chain(), chain_lookup(false), fixture_taps(), ibl::dfg_lut_layout{}, fis_n(i),
+        return {ibl::specular_lobe_taps(fixture_chain(), chain_lookup(false), fixture_taps(), fis_n(i),
                                         fis_v(i), taps_r(i), fis_f0(i), v3(1.0f)),
                 0.0f};
     if (j == 27) { // incidence tangent; every fourth case R = n (the frame's tangent)
@@ -663,7 +664,7 @@ v4 row_value(int j, int i) {
     }
     if (j == 4) {
         const float r = 1.0f - x;
-        const auto a = ibl::dfg_lut_coord(x, r, 128u, ibl::dfg_lut_layout{});
+        const auto a = ibl::dfg_lut_coord(x, r, 128u, ibl::dfg_lut_layout::remapped());
         const auto b = ibl::dfg_lut_coord(x, r, 128u, ibl::dfg_lut_layout::uniform());
         return {a.x, a.y, b.x, b.y};
     }

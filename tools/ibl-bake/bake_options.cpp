@@ -2,6 +2,8 @@
 
 #include "bake_options.hpp"
 
+#include <ibl/integrate/prefilter.hpp>
+
 #include <algorithm>
 #include <charconv>
 #include <cmath>
@@ -24,15 +26,7 @@ quality_settings settings_for(quality q) {
     }
 }
 
-int auto_levels(int size) {
-    int log2n = 0;
-    while ((size >> (log2n + 1)) > 0) ++log2n;
-    const int full = log2n + 1;
-    int l = log2n - 1;
-    if (l < 1) l = 1;
-    if (l > 6) l = 6;
-    return l < full ? l : full;
-}
+int auto_levels(int size) { return ibl::prefilter_auto_levels(size); }
 
 namespace {
 
@@ -83,18 +77,23 @@ std::string path_value(const std::string& option, const std::string& v) {
 }
 
 /// The conventions of an engine (docs/ibl-bake.md, "Presets").
+/// default = the textbook products (what every renderer that implements Karis's split sum reads:
+/// n.l chain read by textureLod at lod(r), uniform (n.v, r) DFG table, nothing taken out of the
+/// environment); accurate = the more accurate conventions (G1 chain, remapped DFG table, the
+/// fitted lobe LUT, a compact sun taken out as a disk light, the log-geometric chain lookup).
 void apply_preset(bake_options& o, const std::string& p) {
     o.preset = p;
-    const bool engine = p != "default";
+    const bool accurate = p == "accurate";
+    const bool engine = p == "filament" || p == "gltf";
     o.policy = p == "filament" ? "filament" : "linear";
-    o.specular_lookup = engine ? "textbook" : "default";
-    o.dfg_layout = engine ? "uniform" : "remapped";
+    o.specular_lookup = accurate ? "accurate" : "textbook";
+    o.dfg_layout = accurate ? "remapped" : "uniform";
     o.dfg_channels = p == "filament" ? "filament" : "ab";
     o.mirror = p == "filament";
-    o.extract_sun = engine ? "off" : "auto";
+    o.extract_sun = accurate ? "auto" : "off";
     o.irradiance_size = engine ? 0 : 32;
-    o.ld_weight = engine ? "nl" : "g1";
-    o.runtime = engine ? "split-sum" : "lobe";
+    o.ld_weight = accurate ? "g1" : "nl";
+    o.runtime = accurate ? "lobe" : "split-sum";
 }
 
 using handler = std::function<void(bake_options&, const std::string&)>;
@@ -109,7 +108,7 @@ const std::map<std::string, option_spec>& option_table() {
         {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
         {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
         {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
-        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {"default", "filament", "gltf"})); }}},
+        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {"default", "accurate", "filament", "gltf"})); }}},
         {"--policy", {true, [](bake_options& o, const std::string& v) { o.policy = choice("--policy", v, {"linear", "filament"}); }}},
         {"--mirror", {false, [](bake_options& o, const std::string&) { o.mirror = true; }}},
         {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
@@ -137,7 +136,7 @@ const std::map<std::string, option_spec>& option_table() {
              o.dfg_layout = choice("--dfg-layout", v, {"remapped", "uniform"});
          }}},
         {"--specular-lookup", {true, [](bake_options& o, const std::string& v) {
-             o.specular_lookup = choice("--specular-lookup", v, {"default", "textbook"});
+             o.specular_lookup = choice("--specular-lookup", v, {"textbook", "accurate"});
          }}},
         {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {"g1", "nl"}); }}},
         {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {"lobe", "taps2", "split-sum"}); }}},
@@ -243,16 +242,16 @@ std::string usage_text() {
            "  --sh-bands B       SH bands 2..5 (default 3)\n"
            "  --sh-window W      auto (default) | none | Hanning width W: applied to irradiance and shader SH\n"
            "  --irradiance-size N  irradiance map face (default 32), 0 = none\n"
-           "  --extract-sun S    auto (default) | on | off: a compact dominant source becomes lights.json\n"
-           "  --preset P         default | filament | gltf: an engine's conventions (options after it override)\n"
+           "  --extract-sun S    off (default) | auto | on: a compact dominant source becomes lights.json\n"
+           "  --preset P         default (textbook products) | accurate | filament | gltf (docs/ibl-bake.md);\n"
+           "                     options after it override what it sets\n"
            "  --policy P         linear (default) | filament: roughness <-> lod of the chain\n"
            "  --mirror           mirror the environment (x -> -x)\n"
            "  --sheen            also the Charlie sheen chain and the sheen albedo LUT\n"
-           "  --dfg-layout L     remapped (default: cbrt(n.v), sqrt(r), edge-aligned) | uniform\n"
-           "  --specular-lookup S  default (log-geometric blend of two levels) | textbook (textureLod)\n"
-           "  --ld-weight W      g1 (default: D G1, the true lobe at n.v = 1) | nl (Karis D n.l): the chain's weight\n"
-           "  --runtime M        lobe (default: LD(lerp(n, R, s), r_eff) from the lobe LUT) | taps2 (two fitted taps,\n"
-           "                     lobe_taps_{a,b}.exr) | split-sum (LD(R, r) DFG)\n"
+           "  --dfg-layout L     uniform (default: texel centres in n.v, r) | remapped (cbrt n.v, sqrt r)\n"
+           "  --specular-lookup S  textbook (default: textureLod at lod(r)) | accurate (log-geometric)\n"
+           "  --ld-weight W      nl (default: Karis D n.l) | g1 (D G1, the true lobe at n.v = 1)\n"
+           "  --runtime M        split-sum (default: LD(R, r) DFG) | lobe (lobe LUT) | taps2 (two fitted taps)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
            "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R, taps NV R\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"

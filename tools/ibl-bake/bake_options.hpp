@@ -15,7 +15,7 @@
 //   --size N            face size of the prefiltered base level, 1..4096 (default 256)
 //   --lut-size N        DFG LUT texels per side, 1..1024 (default 128)
 //   --levels N          prefiltered levels, 0 = automatic (default): floor(log2 N) - 1 clamped
-//                       to [1, 6] (smallest face >= 4 for N >= 16), at most the full chain
+//                       to [2, 6] (smallest face >= 4 for N >= 16), at most the full chain
 //   --threads N         worker threads, 0 = all cores (default 0), at most 256
 //   --quality Q         low | default | high (the mapping is quality_settings below)
 //   --ktx2-format F     rgba16f = f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | rgba32f = f32 |
@@ -24,17 +24,19 @@
 //   --sh-bands B        SH bands 2..5 (default: 3; a scene plan's 2 or 3)
 //   --sh-window W       auto (default) | none | a Hanning width > 0 (applies to irradiance / shader)
 //   --irradiance-size N irradiance map face 1..256 (default 32), 0 = no map (full bake)
-//   --extract-sun S     auto (default: extract a compact dominant source as a disk light) | on | off
-//   --preset P          default | filament | gltf: the conventions of an engine (docs/ibl-bake.md);
-//                       options after it override what it sets
+//   --extract-sun S     off (default: the products hold the whole environment) | auto (extract a
+//                       compact dominant source as a disk light, lights.json) | on
+//   --preset P          default (the textbook products) | accurate | filament | gltf: a set of
+//                       conventions (docs/ibl-bake.md); options after it override what it sets
 //   --policy P          linear (default) | filament: the roughness <-> lod mapping of the chain
 //   --mirror            mirror the environment (x -> -x), as Filament's cmgen does by default
 //   --sheen             also the sheen products (Charlie chain sheen_*.exr / sheen.ktx2, sheen_lut.exr)
-//   --dfg-layout L      remapped (default: cbrt(n.v) x sqrt(r), edge-aligned) | uniform (texel centres)
-//   --specular-lookup S default (log-geometric two-level blend) | textbook (textureLod at lod(r))
-//   --ld-weight W       g1 (default: D G1, the lobe at n.v = 1) | nl (Karis's D n.l): the chain's weight
-//   --runtime M         lobe (default: the lobe LUT, lobe_lut.exr) | taps2 (the fitted two-tap model,
-//                       lobe_taps_a.exr, lobe_taps_b.exr) | split-sum (LD(R, r) DFG)
+//   --dfg-layout L      uniform (default: texel centres in (n.v, r)) | remapped (cbrt(n.v) x sqrt(r),
+//                       edge-aligned)
+//   --specular-lookup S textbook (default: textureLod at lod(r)) | accurate (log-geometric two-level blend)
+//   --ld-weight W       nl (default: Karis's D n.l) | g1 (D G1, the lobe at n.v = 1): the chain's weight
+//   --runtime M         split-sum (default: LD(R, r) DFG) | lobe (the lobe LUT, lobe_lut.exr) | taps2
+//                       (the fitted two-tap model, lobe_taps_a.exr, lobe_taps_b.exr)
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
@@ -77,16 +79,16 @@ struct bake_options {
     int sh_bands = 0;                          ///< --sh-bands 2..5; 0: the plan's (3 in the full bake)
     std::string sh_window = "auto";            ///< auto | none | a Hanning width W > 0
     int irradiance_size = 32;                  ///< --irradiance-size: face of the irradiance map (0: none)
-    std::string extract_sun = "auto";
+    std::string extract_sun = "off";           ///< auto (a compact dominant source as a disk light) | on | off
     bool sheen = false;                        ///< --sheen: the Charlie sheen chain and LUT
-    std::string preset = "default";            ///< default | filament | gltf (sets the fields below)
+    std::string preset = "default";            ///< default (textbook) | accurate | filament | gltf (sets the fields below)
     std::string policy = "linear";             ///< roughness <-> lod: linear | filament (lod = r (2 - r) ...)
     std::string dfg_channels = "ab";           ///< ab: (A, B, k) | filament: (B, A + B, k) for mix(x, y, f0)
-    bool mirror = false;                       ///< the environment mirrored x -> -x (cmgen's default)          ///< auto | on | off
-    std::string dfg_layout = "remapped";       ///< remapped (ibl::dfg_lut_layout{}) | uniform
-    std::string specular_lookup = "default";   ///< default (log-geometric) | textbook
-    std::string ld_weight = "g1";              ///< the chain's LD weight: g1 | nl (ibl::ld_weight)
-    std::string runtime = "lobe";              ///< the runtime model: lobe (lobe LUT) | taps2 (two-tap table) | split-sum
+    bool mirror = false;                       ///< the environment mirrored x -> -x (cmgen's default)
+    std::string dfg_layout = "uniform";        ///< uniform (ibl::dfg_lut_layout::uniform(), textbook) | remapped
+    std::string specular_lookup = "textbook";  ///< textbook (textureLod at lod(r)) | accurate (log-geometric)
+    std::string ld_weight = "nl";              ///< the chain's LD weight: nl (Karis) | g1 (ibl::ld_weight)
+    std::string runtime = "split-sum";         ///< the runtime model: split-sum | lobe (lobe LUT) | taps2 (two-tap table)
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)

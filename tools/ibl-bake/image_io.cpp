@@ -57,6 +57,7 @@
 #include <ImfOutputFile.h>
 #include <ImfPartType.h>
 #include <ImfRgbaFile.h>
+#include <ImfStringAttribute.h>
 #include <ImfTiledInputPart.h>
 #include <ImfTiledOutputFile.h>
 #include <ImfVersion.h>
@@ -1004,12 +1005,19 @@ float srgb_oetf(float x) noexcept {
 }
 } // namespace
 
-std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name) {
+namespace {
+void insert_attributes(Imf::Header& header, const exr_attributes& attributes) {
+    for (const auto& [key, value] : attributes) header.insert(key, Imf::StringAttribute(value));
+}
+} // namespace
+
+std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name, const exr_attributes& attributes) {
     check_image(image, name);
     std::vector<unsigned char> out;
     try {
         Imf::Header header(image.width, image.height);
         header.compression() = Imf::ZIP_COMPRESSION;
+        insert_attributes(header, attributes);
         for (const char* ch : {"R", "G", "B"}) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
         vector_ostream os(out);
         Imf::OutputFile file(os, header, exr_threads);
@@ -1028,15 +1036,37 @@ std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::stri
     return out;
 }
 
-void write_exr(const std::string& path, const image_rgb32f& image) { write_file_atomic(path, encode_exr(image, path)); }
+void write_exr(const std::string& path, const image_rgb32f& image, const exr_attributes& attributes) {
+    write_file_atomic(path, encode_exr(image, path, attributes));
+}
 
-std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name) {
+exr_attributes read_exr_string_attributes(const std::string& path) {
+    const std::vector<unsigned char> bytes = read_file(path);
+    const std::span<const unsigned char> b(bytes);
+    if (b.size() < 8 || std::memcmp(b.data(), exr_magic, 4) != 0) throw image_error(path, "not an OpenEXR file");
+    (void)scan_exr_headers(b, path, read_options{});
+    span_istream in(b, path);
+    exr_attributes out;
+    try {
+        Imf::MultiPartInputFile file(in, exr_threads);
+        const Imf::Header& h = file.header(0);
+        for (auto it = h.begin(); it != h.end(); ++it)
+            if (const auto* a = dynamic_cast<const Imf::StringAttribute*>(&it.attribute())) out.emplace_back(it.name(), a->value());
+    } catch (const std::exception& e) {
+        throw image_error(path, std::string(in.past_end() ? "truncated OpenEXR file" : "corrupt OpenEXR data") + " (OpenEXR: " +
+                                    printable(e.what(), 200) + ")");
+    }
+    return out;
+}
+
+std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name, const exr_attributes& attributes) {
     if (image.width < 1 || image.height < 1 || image.rgba.size() != std::size_t(image.width) * std::size_t(image.height) * 4)
         throw image_error(name, "RGBA image of " + std::to_string(image.rgba.size()) + " floats does not match its size");
     std::vector<unsigned char> out;
     try {
         Imf::Header header(image.width, image.height);
         header.compression() = Imf::ZIP_COMPRESSION;
+        insert_attributes(header, attributes);
         const char* names[4] = {"R", "G", "B", "A"};
         for (const char* ch : names) header.channels().insert(ch, Imf::Channel(Imf::FLOAT));
         vector_ostream os(out);
@@ -1053,7 +1083,9 @@ std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std
     return out;
 }
 
-void write_exr_rgba(const std::string& path, const image_rgba32f& image) { write_file_atomic(path, encode_exr_rgba(image, path)); }
+void write_exr_rgba(const std::string& path, const image_rgba32f& image, const exr_attributes& attributes) {
+    write_file_atomic(path, encode_exr_rgba(image, path, attributes));
+}
 
 image_rgba32f read_exr_rgba(const std::string& path) {
     const std::vector<unsigned char> bytes = read_file(path);

@@ -72,6 +72,7 @@
 #include <span>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace ibl_bake {
@@ -158,9 +159,19 @@ image_rgb32f read_latlong(const std::string& path, const read_options& options =
 
 // ---- writing ---------------------------------------------------------------------------------
 
-/// Float32 RGB OpenEXR (channels B, G, R as OpenEXR orders them; ZIP compression, lossless).
-std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name = "<exr>");
-void write_exr(const std::string& path, const image_rgb32f& image);
+/// String attributes written into an OpenEXR header (name, value): the conventions of a product
+/// (ibl-bake writes ibl.* attributes: docs/ibl-bake.md, "Conventions in the files").
+using exr_attributes = std::vector<std::pair<std::string, std::string>>;
+
+/// Float32 RGB OpenEXR (channels B, G, R as OpenEXR orders them; ZIP compression, lossless), with
+/// the given string attributes in its header.
+std::vector<unsigned char> encode_exr(const image_rgb32f& image, const std::string& name = "<exr>",
+                                      const exr_attributes& attributes = {});
+void write_exr(const std::string& path, const image_rgb32f& image, const exr_attributes& attributes = {});
+
+/// The string attributes of an OpenEXR file's first part (the file is checked as read_image checks
+/// it first). Throws image_error.
+exr_attributes read_exr_string_attributes(const std::string& path);
 
 /// A four-channel float image (R, G, B, A interleaved, row 0 first): the lobe LUT's file.
 struct image_rgba32f {
@@ -169,8 +180,9 @@ struct image_rgba32f {
 };
 /// Float32 RGBA OpenEXR (ZIP); read back by read_exr_rgba (a missing channel reads as 0; the data
 /// window must start at (0, 0), at most 4096 x 4096). Both throw image_error.
-std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name = "<exr>");
-void write_exr_rgba(const std::string& path, const image_rgba32f& image);
+std::vector<unsigned char> encode_exr_rgba(const image_rgba32f& image, const std::string& name = "<exr>",
+                                           const exr_attributes& attributes = {});
+void write_exr_rgba(const std::string& path, const image_rgba32f& image, const exr_attributes& attributes = {});
 image_rgba32f read_exr_rgba(const std::string& path);
 
 /// Radiance HDR (RGBE, run-length encoded for widths 8..32767). RGBE stores one shared exponent e

@@ -117,7 +117,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
     if (word == "dfg") {
         need(2);
         if (!b.has_lut) throw std::invalid_argument("the bake has no DFG table");
-        const fvec3 ab = ibl::dfg_lookup(b.lut, float(unit_interval(a[0])), float(unit_interval(a[1])), b.dfg_layout);
+        const fvec3 ab = ibl::dfg_lookup(b.lut, float(unit_interval(a[0])), float(unit_interval(a[1])));
         return fmt9(ab.x) + " " + fmt9(ab.y);
     }
     if (word == "irradiance") {
@@ -197,6 +197,7 @@ void load_taps(baked_folder& b, const std::string& dir) {
     b.taps.taps = 2;
     b.taps.channels = 8;
     b.taps.weight = b.weight;
+    b.taps.layout = b.dfg_layout;
     b.taps.data.resize(std::size_t(b.taps.size) * b.taps.size * 8);
     for (std::size_t k = 0; k < std::size_t(b.taps.size) * b.taps.size; ++k)
         for (std::size_t c = 0; c < 4; ++c) {
@@ -204,6 +205,15 @@ void load_taps(baked_folder& b, const std::string& dir) {
             b.taps.data[k * 8 + 4 + c] = tb.rgba[k * 4 + c];
         }
     b.has_taps = true;
+}
+
+/// A table file whose ibl.dfg_layout attribute names another layout than report.json is refused
+/// (files of two bakes mixed in one folder); files without the attribute take report.json's.
+void check_layout_attribute(const std::string& path, const ibl::dfg_lut_layout& expected) {
+    for (const auto& [k, v] : read_exr_string_attributes(path))
+        if (k == "ibl.dfg_layout" && v != expected.name())
+            throw std::runtime_error(path + ": the table is in the " + v + " layout, report.json says " + expected.name() +
+                                     " (files of different bakes?)");
 }
 
 /// The runtime model of plan.runtime (bakes before it: the split sum of an n.l chain).
@@ -220,6 +230,8 @@ void load_runtime_model(baked_folder& b, const json_value& rt, const std::string
     b.lobe.size = std::uint32_t(img.width);
     b.lobe.data = img.rgba;
     b.lobe.weight = b.weight;
+    b.lobe.layout = b.dfg_layout;
+    check_layout_attribute(dir + "/lobe_lut.exr", b.dfg_layout);
     b.has_lobe = true;
 }
 } // namespace
@@ -236,7 +248,7 @@ baked_folder load_baked_folder(const std::string& dir) {
         b.chain = cube_from_ktx2(dir + "/specular.ktx2");
         b.has_chain = true;
     }
-    b.specular = specular_lookup_named(member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? "textbook" : "default");
+    b.specular = specular_lookup_named(member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? "textbook" : "accurate");
     b.dfg_layout = dfg_layout_named(member(member(rt, "dfg_layout", rp), "edge_aligned", rp).boolean ? "remapped" : "uniform");
     b.specular.mapping = b.filament_policy ? ibl::roughness_mapping::filament : ibl::roughness_mapping::linear;
     if (member(rt, "dfg_size", rp).number > 0) {
@@ -246,6 +258,8 @@ baked_folder load_baked_folder(const std::string& dir) {
                 const float x = b.lut.data[k], y = b.lut.data[k + 1];
                 b.lut.data[k] = y - x, b.lut.data[k + 1] = x;
             }
+        b.lut.layout = b.dfg_layout;
+        check_layout_attribute(dir + "/dfg.exr", b.dfg_layout);
         b.has_lut = true;
     }
     if (fs_exists(dir + "/lights.json")) {

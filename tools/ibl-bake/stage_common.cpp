@@ -74,7 +74,7 @@ dvec3 sheen_sun_ld(const ibl::disk_light<double>* sun, const dvec3& R, double ro
 }
 
 ibl::vec4<double> product_view::lobe_params(double n_dot_v, double roughness) const {
-    return ibl::vec4<double>(ibl::lobe_lut_lookup(*lobe, float(n_dot_v), float(roughness), dfg_layout));
+    return ibl::vec4<double>(ibl::lobe_lut_lookup(*lobe, float(n_dot_v), float(roughness)));
 }
 
 std::array<float, 8> product_view::taps_params(double n_dot_v, double roughness) const {
@@ -125,7 +125,7 @@ ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, dou
     }
     s.ld = ld(r_dir, roughness);
     if (lut) {
-        const fvec3 ab = ibl::dfg_lookup(*lut, float(n_dot_v), float(roughness), dfg_layout);
+        const fvec3 ab = ibl::dfg_lookup(*lut, float(n_dot_v), float(roughness));
         s.dfg = ibl::vec2<double>(ab.x, ab.y);
     } else {
         s.dfg = ibl::dfg_exact<bake_model>(n_dot_v, roughness);
@@ -134,11 +134,11 @@ ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, dou
 }
 
 ibl::dfg_lut_layout dfg_layout_named(const std::string& name) {
-    return name == "uniform" ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout{};
+    return name == "uniform" ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout::remapped();
 }
 
 ibl::specular_lookup_desc specular_lookup_named(const std::string& name) {
-    return name == "textbook" ? ibl::specular_lookup_desc::textbook() : ibl::specular_lookup_desc{};
+    return name == "accurate" ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
 }
 
 ibl::ld_weight ld_weight_named(const std::string& name) { return name == "g1" ? ibl::ld_weight::g1 : ibl::ld_weight::n_dot_l; }
@@ -210,6 +210,23 @@ void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s,
     j.end_object();
 }
 
+std::vector<std::pair<std::string, std::string>> product_conventions(const bake_context& ctx, const std::string& product,
+                                                                     const std::string& how_to_read) {
+    return {{"ibl.preset", ctx.opt.preset},
+            {"ibl.product", product},
+            {"ibl.sun_extracted", ctx.sun ? "yes: a compact bright source was taken out into lights.json (a disk light the "
+                                            "renderer must add); this file holds the rest of the environment"
+                                          : "no: this file holds the whole environment"},
+            {"ibl.conventions", how_to_read}};
+}
+
+std::vector<std::pair<std::string, std::string>> table_layout_keys(const ibl::dfg_lut_layout& layout) {
+    return {{"ibl.dfg_layout", layout.name()},
+            {"ibl.dfg_lookup", layout == ibl::dfg_lut_layout::uniform()
+                                   ? "texture(lut, vec2(n.v, roughness)): texel (i, j) holds n.v = (i + 0.5) / N, r = (j + 0.5) / N"
+                                   : "texture(lut, ibl_dfg_lut_coord(n.v, roughness, N, layout)) (ibl/glsl/ibl_lookup.glsl)"}};
+}
+
 product_view baked_view(const bake_context& ctx) {
     product_view v;
     v.specular = specular_lookup_named(ctx.opt.specular_lookup);
@@ -273,7 +290,7 @@ double ab_vs_dfg(const std::vector<float>& data, std::uint32_t n, std::uint32_t 
         for (std::uint32_t i = 0; i < n; ++i) {
             const float nv = ibl::dfg_texel_value<float>(layout.n_dot_v, i, n, layout.edge_aligned);
             const float r = ibl::dfg_texel_value<float>(layout.roughness, j, n, layout.edge_aligned);
-            const fvec3 ab = ibl::dfg_lookup(dfg, nv, r, layout);
+            const fvec3 ab = ibl::dfg_lookup(dfg, nv, r);
             const float* t = &data[(std::size_t(j) * n + i) * channels];
             m = std::max({m, std::fabs(double(t[0]) - ab.x), std::fabs(double(t[1]) - ab.y)});
         }

@@ -40,12 +40,19 @@ public:
                                                       std::uint32_t(ctx.plan.dfg.channels), nodes_, ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lut;
+        attrs_ = product_conventions(ctx, "dfg",
+                                     std::string(filament_channels_ ? "R = B, G = A + B, B = k (specular = LD mix(R, G, F0))"
+                                                                    : "R = A, G = B, B = k (specular = LD (F0 A + F90 B))") +
+                                         "; EXR row 0 (top) is the smallest roughness");
+        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
+        attrs_.push_back({"ibl.model", lut_->model});
+        attrs_.push_back({"ibl.dfg_channels", filament_channels_ ? "B, A + B, k" : "A, B, k"});
         ctx.prog.begin("check dfg");
         check(ctx.ex);
         const ibl::dfg_error_grid grid = ibl::dfg_error_grid::dense(33, 24, 0.05);
         const std::vector<ibl::vec2<double>> exact = ibl::dfg_exact_grid<bake_model>(grid, ctx.ex);
-        lookup_ = ibl::dfg_lookup_error(*lut_, layout_, grid, exact);
-        lookup_half_ = ibl::dfg_lookup_error(ibl::quantize_half_lut(*lut_), layout_, grid, exact);
+        lookup_ = ibl::dfg_lookup_error(*lut_, grid, exact);
+        lookup_half_ = ibl::dfg_lookup_error(ibl::quantize_half_lut(*lut_), grid, exact);
         check_ms_ = ctx.prog.end();
     }
 
@@ -93,6 +100,7 @@ private:
         return t;
     }
     ibl::dfg_lookup_report lookup_, lookup_half_;
+    std::vector<std::pair<std::string, std::string>> attrs_;
     ibl::dfg_quadrature_nodes nodes_{};
     std::string quality_;
     double ms_ = 0.0, check_ms_ = 0.0, max_abs_ = 0.0;
@@ -107,7 +115,7 @@ std::vector<file_out> dfg_stage::files() const {
                  for (std::uint32_t j = 0; j < t.size; ++j)
                      for (std::uint32_t i = 0; i < t.size; ++i)
                          for (std::uint32_t c = 0; c < t.channels && c < 3; ++c) d.texel(int(i), int(j))[c] = t.at(i, j, c);
-                 write_exr(p, d);
+                 write_exr(p, d, attrs_);
              }},
             {"dfg.hpp", [this](const std::string& p) {
                  write_text(p, ibl::dfg_lut_header(file_lut(), "dfg_lut", "ibl_baked",
@@ -137,7 +145,7 @@ void dfg_stage::report(json_writer& j) const {
     j.end_object();
     j.key("time_ms").value(ms_);
     j.key("layout").value(layout_.edge_aligned
-                              ? "x: n.v = (i / (N - 1))^3, y: roughness = (j / (N - 1))^2 (edge-aligned; ibl::dfg_lut_layout{}); EXR row 0 "
+                              ? "x: n.v = (i / (N - 1))^3, y: roughness = (j / (N - 1))^2 (edge-aligned; ibl::dfg_lut_layout::remapped()); EXR row 0 "
                                 "(top) = roughness 0, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)"
                               : "x = n.v = (i + 0.5)/N, y = roughness = (j + 0.5)/N (texel centres); EXR row 0 (top) = "
                                 "roughness 0.5/N, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)");

@@ -124,6 +124,8 @@ public:
             ctx.diffuse.radiance = rad_;
             ctx.diffuse.shader_over_pi = shader_;
         }
+        conventions_ = product_conventions(ctx, "sh", "real SH radiance coefficients; E(n) and E(n)/pi reconstructed as "
+                                                      "'convention' says");
         check(ctx);
     }
 
@@ -183,6 +185,7 @@ private:
     void check(bake_context& ctx);
     std::string sh_json() const;
 
+    std::vector<std::pair<std::string, std::string>> conventions_;
     int bands_ = 3, texels_ = 0;
     std::string window_ = "auto";
     bool windowed_ = false, sun_ = false, filament_ = false;
@@ -221,6 +224,9 @@ std::string sh_stage::sh_json() const {
     j.key("irradiance_over_pi_shader" + suffix);
     json_triples(j, shader_, count);
     j.key("convention").value(sh_convention);
+    j.key("conventions").begin_object();
+    for (const auto& [k, v] : conventions_) j.key(k).value(v);
+    j.end_object();
     j.key("window").begin_object();
     j.key("applied").value(windowed_);
     j.key("kind").value("hanning");
@@ -281,6 +287,8 @@ public:
         ms_ = ctx.prog.end();
         map_ = &ctx.diffuse.map;
         format_ = ctx.opt.ktx2_format;
+        attrs_ = product_conventions(ctx, "irradiance", "texel holds the irradiance E(n) (not E/pi) for the normal n through "
+                                                        "it; diffuse = albedo E(n) / pi");
         const auto t0 = std::chrono::steady_clock::now();
         c_.level = level_at_most(ctx.source, brute_max_face);
         c_.face = ctx.source.size(c_.level);
@@ -303,9 +311,10 @@ public:
         std::vector<file_out> f;
         for (int face = 0; face < 6; ++face)
             f.push_back({std::string("irradiance_") + face_names[face] + ".exr",
-                         [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0)); }});
+                         [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0), attrs_); }});
         f.push_back({"irradiance.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_named(format_), "ibl-bake " + version_string(),
+                                            attrs_);
                      }});
         return f;
     }
@@ -327,6 +336,7 @@ public:
 private:
     int size_ = 32, max_face_ = 32;
     std::string format_;
+    std::vector<std::pair<std::string, std::string>> attrs_;
     const ibl::cubemap<float>* map_ = nullptr;
     double ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     bool sun_ = false;

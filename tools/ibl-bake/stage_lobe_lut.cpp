@@ -51,6 +51,10 @@ public:
         ctx.lobe = ibl::make_lobe_lut_fitted<bake_model>(size, layout_, weight_, ibl::lobe_fit_options{}, ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lobe;
+        attrs_ = product_conventions(ctx, "lobe_lut", "R = A, G = B, B = s, A = r_eff: specular = LD(normalize(mix(n, R, s)), "
+                                                      "r_eff) (F0 A + F90 B), LD from a chain of weight ibl.ld_weight");
+        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
+        attrs_.push_back({"ibl.ld_weight", weight_name_});
         ctx.prog.begin("check lobe lut");
         ab_max_abs_ = ab_vs_dfg(lut_->data, lut_->size, 4, layout_, *ctx.lut);
         check_midpoints(ctx.ex);
@@ -73,6 +77,7 @@ private:
 
     const ibl::lobe_lut* lut_ = nullptr;
     ibl::dfg_lut_layout layout_{};
+    std::vector<std::pair<std::string, std::string>> attrs_;
     ibl::ld_weight weight_ = ibl::ld_weight::g1;
     std::string weight_name_;
     double ms_ = 0.0, check_ms_ = 0.0, ab_max_abs_ = 0.0;
@@ -93,7 +98,7 @@ void lobe_lut_stage::check_midpoints(pool_executor& ex) {
     ex(pts.size(), [&](std::size_t b, std::size_t e) {
         for (std::size_t k = b; k < e; ++k) {
             const double nv = pts[k][0], r = pts[k][1];
-            const ibl::vec4<float> p = ibl::lobe_lut_lookup(*lut_, float(nv), float(r), layout_);
+            const ibl::vec4<float> p = ibl::lobe_lut_lookup(*lut_, float(nv), float(r));
             const ibl::detail::lobe_points lp = ibl::detail::make_lobe_points<bake_model>(nv, r, check_nodes);
             std::array<ibl::lobe_tap, ibl::lobe_max_taps> t{};
             t[0] = tap_of(nv, p.z, p.w);
@@ -117,7 +122,7 @@ std::vector<file_out> lobe_lut_stage::files() const {
                                                     "sample at ibl::dfg_lut_coord)"
                                                   : "n.v = (i + 0.5) / size, roughness = (j + 0.5) / size";
     return {{"lobe_lut.exr",
-             [this](const std::string& p) { write_exr_rgba(p, image_rgba32f{int(lut_->size), int(lut_->size), lut_->data}); }},
+             [this](const std::string& p) { write_exr_rgba(p, image_rgba32f{int(lut_->size), int(lut_->size), lut_->data}, attrs_); }},
             {"lobe_lut.hpp", [this, rule](const std::string& p) {
                  write_text(p, c_table_header("lobe_lut", std::string("the lobe LUT of ibl/runtime.hpp (") + bake_model::name +
                                                               ", chain weight " + weight_name_ + ")",

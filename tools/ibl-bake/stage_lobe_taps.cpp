@@ -72,6 +72,11 @@ public:
         ctx.taps = ibl::make_lobe_taps_lut<bake_model>(size, layout_, weight_, fit_options(), ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.taps;
+        attrs_ = product_conventions(ctx, "lobe_taps", "lobe_taps_a = (A, B, a_0, r_0), lobe_taps_b = (w_0, a_1, r_1, w_1): "
+                                                       "specular = (F0 A + F90 B) sum_k w_k LD(cos(a_k acos(n.v)) n + sin(...) t, r_k) "
+                                                       "/ sum_k w_k (ibl_specular_lobe_taps2)");
+        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
+        attrs_.push_back({"ibl.ld_weight", weight_name_});
         ctx.prog.begin("check lobe taps");
         ab_max_abs_ = ab_vs_dfg(lut_->data, lut_->size, lut_->channels, layout_, *ctx.lut);
         check_midpoints(ctx.ex);
@@ -94,6 +99,7 @@ private:
 
     const ibl::lobe_taps_lut* lut_ = nullptr;
     ibl::dfg_lut_layout layout_{};
+    std::vector<std::pair<std::string, std::string>> attrs_;
     ibl::ld_weight weight_ = ibl::ld_weight::g1;
     std::string weight_name_;
     double ms_ = 0.0, check_ms_ = 0.0, ab_max_abs_ = 0.0;
@@ -142,8 +148,8 @@ std::vector<file_out> lobe_taps_stage::files() const {
     const std::string rule = layout_.edge_aligned ? "n.v = (i / (size - 1))^3, roughness = (j / (size - 1))^2 (edge-aligned; "
                                                     "sample at ibl::dfg_lut_coord)"
                                                   : "n.v = (i + 0.5) / size, roughness = (j + 0.5) / size";
-    return {{"lobe_taps_a.exr", [this](const std::string& p) { write_exr_rgba(p, taps_image(*lut_, 0)); }},
-            {"lobe_taps_b.exr", [this](const std::string& p) { write_exr_rgba(p, taps_image(*lut_, 4)); }},
+    return {{"lobe_taps_a.exr", [this](const std::string& p) { write_exr_rgba(p, taps_image(*lut_, 0), attrs_); }},
+            {"lobe_taps_b.exr", [this](const std::string& p) { write_exr_rgba(p, taps_image(*lut_, 4), attrs_); }},
             {"lobe_taps.hpp", [this, rule](const std::string& p) {
                  write_text(p, c_table_header("lobe_taps",
                                               std::string("the two-tap table of ibl/runtime.hpp specular_lobe_taps (") +

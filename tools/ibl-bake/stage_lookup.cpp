@@ -52,7 +52,7 @@ public:
             encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
         const ibl::cubemap<float> stored = cubemap_from_rgb32f(decode_ktx2_cubemap(bytes, "specular.ktx2"));
         const bool textbook = ctx.opt.specular_lookup == "textbook";
-        ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "default" : "textbook");
+        ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "accurate" : "textbook");
         other.mapping = chosen.mapping;
         const std::string chosen_name = textbook ? "textbook (chosen)" : "log-geometric (chosen)";
         const std::string stored_name = "as stored in specular.ktx2 (" + ctx.opt.ktx2_format + ")";

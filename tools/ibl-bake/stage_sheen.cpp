@@ -58,6 +58,10 @@ public:
         ms_ = ctx.prog.end();
         format_ = ctx.opt.ktx2_format;
         samples_ = po.samples_per_level;
+        attrs_ = product_conventions(ctx, "sheen", "level l holds the Charlie-lobe LD at roughness l / (levels - 1) (linear), read "
+                                                   "at R by textureLod(chain, R, lod(r))");
+        lut_attrs_ = product_conventions(ctx, "sheen_lut", "R = sheen albedo E(n.v, r) (Charlie NDF, Neubelt visibility)");
+        for (auto& kv : table_layout_keys(lut_.layout)) lut_attrs_.push_back(kv);
         ctx.prog.begin("check sheen");
         const auto t0 = std::chrono::steady_clock::now();
         // Level 0 (r = 0: a ring of zero width at R's horizon) is below any texel sum's resolution:
@@ -83,21 +87,23 @@ public:
         for (int l = 0; l < chain_.levels(); ++l)
             for (int face = 0; face < 6; ++face)
                 f.push_back({"sheen_l" + std::to_string(l) + "_" + face_names[face] + ".exr",
-                             [this, l, face](const std::string& p) { write_exr(p, face_image(chain_, face, l)); }});
+                             [this, l, face](const std::string& p) { write_exr(p, face_image(chain_, face, l), attrs_); }});
         f.push_back({"sheen.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_named(format_), "ibl-bake " + version_string());
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_named(format_), "ibl-bake " + version_string(),
+                                            attrs_);
                      }});
         f.push_back({"sheen_lut.exr", [this](const std::string& p) {
                          image_rgb32f img(int(lut_.size), int(lut_.size));
                          for (std::uint32_t j = 0; j < lut_.size; ++j)
                              for (std::uint32_t i = 0; i < lut_.size; ++i) img.texel(int(i), int(j))[0] = lut_.at(i, j, 0);
-                         write_exr(p, img);
+                         write_exr(p, img, lut_attrs_);
                      }});
         return f;
     }
     void report(json_writer& j) const override;
 
 private:
+    std::vector<std::pair<std::string, std::string>> attrs_, lut_attrs_;
     /// Level l plus the sun's term against the exact Charlie LD of the source before extraction
     /// (ibl::reference_ld_texel_sum_lobe over its first level of face <= 64; a sampled reference
     /// does not converge on a sun).

@@ -38,14 +38,24 @@ std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_conte
         if (!r.empty()) r.push_back(' ');
         r.append(fmt("%.9g", l.roughness));
     }
-    return {{"ibl.first_level", std::to_string(sp.first_level)},
-            {"ibl.ld_weight", ctx.opt.ld_weight},
-            {"ibl.level_roughness", r},
-            {"ibl.policy", ctx.opt.policy == "filament" ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r"},
-            {"ibl.preset", ctx.opt.preset},
-            {"ibl.runtime", runtime_model_of(ctx.opt, ctx.plan).name},
-            {"ibl.specular_lookup", ctx.opt.specular_lookup},
-            {"ibl.virtual_levels", std::to_string(sp.virtual_levels)}};
+    const std::string lookup = ctx.opt.specular_lookup == "accurate"
+                                   ? "the two levels bracketing r blended log-geometrically (ibl_specular_lookup)"
+                                   : "textureLod(chain, R, lod(r))";
+    std::vector<std::pair<std::string, std::string>> m =
+        product_conventions(ctx, "specular",
+                            std::string("level l holds LD at roughness ibl.level_roughness[l], weight ") +
+                                (ctx.opt.ld_weight == "g1" ? "D G1 (the specular lobe at n.v = 1)" : "D n.l (Karis)") +
+                                "; read at R = reflect(-v, n) by " + lookup);
+    for (auto kv : std::vector<std::pair<std::string, std::string>>{
+             {"ibl.first_level", std::to_string(sp.first_level)},
+             {"ibl.ld_weight", ctx.opt.ld_weight},
+             {"ibl.level_roughness", r},
+             {"ibl.policy", ctx.opt.policy == "filament" ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r"},
+             {"ibl.runtime", runtime_model_of(ctx.opt, ctx.plan).name},
+             {"ibl.specular_lookup", ctx.opt.specular_lookup},
+             {"ibl.virtual_levels", std::to_string(sp.virtual_levels)}})
+        m.push_back(kv);
+    return m;
 }
 
 struct level_check {
@@ -103,6 +113,13 @@ private:
     std::vector<std::string> layouts_;
     std::vector<ktx2_quantisation_level> quant_;
     std::vector<std::pair<std::string, std::string>> metadata_;
+    /// The chain's keys plus the level and its roughness (ibl.level, ibl.roughness).
+    exr_attributes level_attrs(int l) const {
+        exr_attributes a = metadata_;
+        a.push_back({"ibl.level", std::to_string(l)});
+        a.push_back({"ibl.roughness", l < int(sp_.levels.size()) ? fmt("%.9g", sp_.levels[std::size_t(l)].roughness) : "?"});
+        return a;
+    }
     quality_settings qs_{};
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
@@ -197,13 +214,16 @@ std::vector<file_out> specular_stage::files() const {
         if (has("faces"))
             for (int face = 0; face < 6; ++face)
                 f.push_back({base + face_names[face] + ".exr",
-                             [this, l, face](const std::string& p) { write_exr(p, face_image(*chain_, face, l)); }});
-        if (has("latlong")) f.push_back({base + "latlong.exr", [this, l](const std::string& p) { write_exr(p, latlong_from_cube(*chain_, l)); }});
+                             [this, l, face](const std::string& p) { write_exr(p, face_image(*chain_, face, l), level_attrs(l)); }});
+        if (has("latlong"))
+            f.push_back({base + "latlong.exr", [this, l](const std::string& p) { write_exr(p, latlong_from_cube(*chain_, l), level_attrs(l)); }});
         if (has("cross"))
-            f.push_back({base + "cross.exr",
-                         [this, l](const std::string& p) { write_exr(p, cross_from_faces(faces_from_cubemap(*chain_, l))); }});
+            f.push_back({base + "cross.exr", [this, l](const std::string& p) {
+                             write_exr(p, cross_from_faces(faces_from_cubemap(*chain_, l)), level_attrs(l));
+                         }});
         if (has("octahedral"))
-            f.push_back({base + "octahedral.exr", [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l)); }});
+            f.push_back({base + "octahedral.exr",
+                         [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l), level_attrs(l)); }});
     }
     f.push_back({"specular.ktx2", [this](const std::string& p) {
                      write_ktx2_cubemap(p, cubemap_to_rgb32f(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string(), metadata_);

@@ -23,6 +23,7 @@
 #include <chrono>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <ibl/brdf/model.hpp>
@@ -133,6 +134,19 @@ void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s,
 
 /// The products of ctx as a renderer samples them.
 product_view baked_view(const bake_context& ctx);
+
+/// The conventions every file of a product states in its metadata (EXR string attributes, KTX2
+/// key/values; the JSON files carry the same under "conventions"): ibl.preset, ibl.product,
+/// ibl.sun_extracted (whether the product holds the whole environment or the residual of an
+/// extracted sun, which lights.json then holds) and ibl.conventions (one sentence on how a
+/// renderer reads the file), then the product's own keys (docs/ibl-bake.md, "Conventions in the
+/// files").
+std::vector<std::pair<std::string, std::string>> product_conventions(const bake_context& ctx, const std::string& product,
+                                                                     const std::string& how_to_read);
+
+/// The keys of a (n.v, r) table: ibl.dfg_layout (ibl::dfg_lut_layout::name()) and ibl.dfg_lookup
+/// (how a shader computes the sampler coordinates).
+std::vector<std::pair<std::string, std::string>> table_layout_keys(const ibl::dfg_lut_layout& layout);
 
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);

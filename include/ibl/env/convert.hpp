@@ -83,7 +83,7 @@ vec3<double> cube_texel_mean(const Env& env, int face, int x, int y, int n, int 
 /// (0 = full chain) using k x k sub-samples per level-0 texel. Throws std::invalid_argument for
 /// n < 1, k < 1 or a bad level count, std::length_error for n > limits::max_face_size,
 /// k > limits::max_subsamples, 6 n^2 k^2 > limits::max_work or a cube above limits::max_texels.
-template <class T, class Env, class Executor = serial_executor>
+template <class T, class Env, class Executor = thread_executor>
     requires environment<Env, T>
 cubemap<T> bake_cubemap(const Env& env, int n, int k, Executor&& ex = Executor{}, int levels = 0, T lod = T(0)) {
     detail::check_bake_args("bake_cubemap", n, k);

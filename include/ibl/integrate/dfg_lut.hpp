@@ -2,12 +2,18 @@
 // ibl/integrate/dfg_lut.hpp — the DFG look-up table: generation (exact or Monte Carlo) through the
 // batch kernels and an executor, layout, and bilinear lookup (host only).
 //
-// Layout (float32, interleaved channels, row-major):
-//   texel (i, j), i, j in [0, size):  x = n.v = (i + 0.5) / size,  y = r = (j + 0.5) / size
-//   (texel centres: r = 0 and n.v = 0 themselves are half a texel outside, as in a GPU texture
-//   sampled with clamp-to-edge). Row j holds one roughness; row 0 (r = 0.5 / size) comes first in
-//   memory, so data[(j * size + i) * channels + c]. Uploaded as is, row 0 is the texture's
-//   first row (v = 0 in GL/Vulkan/D3D texel addressing), so a shader samples at (n.v, r).
+// Layout (float32, interleaved channels, row-major): data[(j * size + i) * channels + c], row j
+// one roughness, row 0 first in memory (uploaded as is, row 0 is the texture's first row, v = 0
+// in GL/Vulkan/D3D texel addressing). Which (n.v, r) a texel holds is the table's `layout`
+// (integrate/dfg_layout.hpp), recorded in the table and read from it by every lookup:
+//   the default, dfg_lut_layout::uniform() (the textbook table):
+//     texel (i, j): n.v = (i + 0.5) / size, r = (j + 0.5) / size (texel centres: r = 0 and n.v = 0
+//     themselves are half a texel outside, as in a GPU texture sampled with clamp-to-edge), so a
+//     shader samples texture(lut, vec2(n.v, r));
+//   dfg_lut_layout::remapped() (the accurate table): cbrt(n.v) x sqrt(r), edge aligned, sampled at
+//     dfg_lut_coord(n.v, r, size, layout).
+// The table also records the BRDF model it integrates (`model`: Model::name, "custom" for a
+// model without one).
 //   channel 0 = A (scale of F0), 1 = B (bias, scale of F90), 2 (optional) = k = (1 - E)/E,
 //   E = A + B: Turquin's multiple-scattering compensation (integrate/dfg_multiscatter.hpp).
 //
@@ -23,6 +29,7 @@
 #include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "../batch/dfg_kernel.hpp"
@@ -31,6 +38,7 @@
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "dfg.hpp"
+#include "dfg_layout.hpp"
 #include "dfg_multiscatter.hpp"
 
 namespace ibl {
@@ -39,11 +47,17 @@ struct dfg_lut {
     std::uint32_t size = 0;     ///< texels per side
     std::uint32_t channels = 0; ///< 2 (A, B) or 3 (A, B, k)
     std::vector<float> data;    ///< (j * size + i) * channels + c
+    dfg_lut_layout layout{};    ///< which (n.v, r) each texel holds (default: the textbook table)
+    std::string model = "custom"; ///< the BRDF model integrated (Model::name)
 
     /// n.v at the centre of column i.
-    double n_dot_v(std::uint32_t i) const noexcept { return (double(i) + 0.5) / double(size); }
+    double n_dot_v(std::uint32_t i) const noexcept {
+        return dfg_texel_value<double>(layout.n_dot_v, i, size, layout.edge_aligned);
+    }
     /// Roughness at the centre of row j.
-    double roughness(std::uint32_t j) const noexcept { return (double(j) + 0.5) / double(size); }
+    double roughness(std::uint32_t j) const noexcept {
+        return dfg_texel_value<double>(layout.roughness, j, size, layout.edge_aligned);
+    }
     /// Texel value. Precondition (noexcept, IBL_ASSERT in debug builds): i, j < size, c < channels,
     /// data holds size^2 channels floats.
     float at(std::uint32_t i, std::uint32_t j, std::uint32_t c) const noexcept {
@@ -54,25 +68,23 @@ struct dfg_lut {
     bool valid() const noexcept {
         return size > 0 && channels > 0 && data.size() == std::size_t(size) * size * channels;
     }
-    /// Bilinear lookup at (n.v, r) with clamp-to-edge, as a GPU sampler does (channel 2 is 0 for a
-    /// two-channel table). A table that is not valid() (empty, or data of the wrong length)
-    /// samples as 0 instead of reading out of bounds.
+    /// Bilinear lookup at (n.v, r) in the table's layout with clamp-to-edge, as a GPU sampler does
+    /// (channel 2 is 0 for a two-channel table; the same read as lookup.hpp's dfg_lookup). A table
+    /// that is not valid() (empty, or data of the wrong length) samples as 0 instead of reading out
+    /// of bounds.
     vec3<float> sample(float n_dot_v, float rough) const noexcept {
         if (!valid()) return vec3<float>(0.0f);
-        const float fx = clamp(n_dot_v * float(size) - 0.5f, 0.0f, float(size - 1));
-        const float fy = clamp(rough * float(size) - 0.5f, 0.0f, float(size - 1));
-        const auto i0 = std::uint32_t(fx), j0 = std::uint32_t(fy);
-        const std::uint32_t i1 = i0 + 1 < size ? i0 + 1 : i0, j1 = j0 + 1 < size ? j0 + 1 : j0;
-        const float tx = fx - float(i0), ty = fy - float(j0);
-        vec3<float> out(0.0f);
-        for (std::uint32_t c = 0; c < channels && c < 3; ++c) {
-            const float top = lerp(at(i0, j0, c), at(i1, j0, c), tx);
-            const float bottom = lerp(at(i0, j1, c), at(i1, j1, c), tx);
-            out[int(c)] = lerp(top, bottom, ty);
-        }
-        return out;
+        const vec2<float> st = dfg_lut_coord(n_dot_v, rough, size, layout);
+        return dfg_sample_st(*this, st.x, st.y);
     }
 };
+
+namespace detail {
+template <class Model> std::string model_name() {
+    if constexpr (requires { Model::name; }) return std::string(Model::name);
+    else return "custom";
+}
+} // namespace detail
 
 /// Node counts used for tables (weights evaluated in float, see dfg_quadrature_lanes): largest
 /// error of the 128^2 float table 4.8e-6 (height-correlated) / 4.2e-6 (Schlick k_IBL) against a
@@ -102,23 +114,31 @@ inline void check_dfg_lut_args(const char* fn, std::uint32_t size, std::uint32_t
 }
 } // namespace detail
 
-/// The exact table of model M (quadrature in double), channels 2 or 3. Throws
-/// std::invalid_argument for size 0, channels other than 2 or 3 or a zero node count,
+/// The exact table of model M (quadrature in double) in a layout, channels 2 or 3: texel (i, j)
+/// holds the quadrature at n.v = dfg_texel_value(layout.n_dot_v, i, ...), r =
+/// dfg_texel_value(layout.roughness, j, ...); the table records the layout and Model::name.
+/// Throws std::invalid_argument for size 0, channels other than 2 or 3 or a zero node count,
 /// std::length_error for size > limits::max_dfg_lut_size, a node count above
 /// limits::max_quadrature_nodes or size^2 * nodes.evaluations() > limits::max_work.
 template <class Model, class Executor = thread_executor>
-dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_quadrature_nodes nodes = dfg_lut_default_nodes,
-                           Executor&& ex = Executor{}) {
+dfg_lut make_dfg_lut_exact(std::uint32_t size, const dfg_lut_layout& layout, std::uint32_t channels = 3,
+                           dfg_quadrature_nodes nodes = dfg_lut_default_nodes, Executor&& ex = Executor{}) {
     detail::check_dfg_nodes("make_dfg_lut_exact", nodes);
     detail::check_dfg_lut_args("make_dfg_lut_exact", size, channels, nodes.evaluations(), "evaluations size^2 * nodes");
     constexpr std::size_t W = 16;
-    dfg_lut lut{size, channels, {}};
+    dfg_lut lut{size, channels, {}, layout, detail::model_name<Model>()};
     lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
     const dfg_quadrature_rule rule(nodes);
     const dfg_quadrature_view q = rule.view();
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {
             const double r = lut.roughness(std::uint32_t(j));
+            if (r <= 0.0) { // the mirror row of an edge-aligned table: the r -> 0 limit in closed form,
+                            // E = 1 and B = (1 - n.v)^5 (the quadrature degenerates at n.v = r = 0)
+                for (std::uint32_t i = 0; i < size; ++i)
+                    detail::dfg_store<double>(lut, i, std::uint32_t(j), 1.0, pow5(1.0 - lut.n_dot_v(i)));
+                continue;
+            }
             std::uint32_t i = 0;
             for (; i + W <= size; i += W) {
                 double mu[W], e[W], b[W];
@@ -137,8 +157,16 @@ dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_q
     return lut;
 }
 
+/// The exact table of model M in the default (textbook) layout, dfg_lut_layout::uniform().
+template <class Model, class Executor = thread_executor>
+dfg_lut make_dfg_lut_exact(std::uint32_t size, std::uint32_t channels = 3, dfg_quadrature_nodes nodes = dfg_lut_default_nodes,
+                           Executor&& ex = Executor{}) {
+    return make_dfg_lut_exact<Model>(size, dfg_lut_layout::uniform(), channels, nodes, std::forward<Executor>(ex));
+}
+
 /// The Monte Carlo table of model M: `samples` Hammersley points with GGX-NDF sampling per texel
-/// (the literature's estimator, float), one sample table per row shared by its texels.
+/// (the literature's estimator, float), one sample table per row shared by its texels, in the
+/// default (textbook) layout.
 /// Channels 2 or 3 (k from the Monte Carlo E). Throws std::invalid_argument for size 0, samples 0
 /// (E = 0: k = inf) or channels other than 2 or 3, std::length_error for size >
 /// limits::max_dfg_lut_size, samples > limits::max_samples or size^2 * samples > limits::max_work.
@@ -147,7 +175,7 @@ dfg_lut make_dfg_lut_mc(std::uint32_t size, std::uint32_t samples, std::uint32_t
     detail::check_arg("make_dfg_lut_mc", "samples", samples, 1u, limits::max_samples, "limits::max_samples");
     detail::check_dfg_lut_args("make_dfg_lut_mc", size, channels, samples, "evaluations size^2 * samples");
     constexpr std::size_t W = 16;
-    dfg_lut lut{size, channels, {}};
+    dfg_lut lut{size, channels, {}, dfg_lut_layout::uniform(), detail::model_name<Model>()};
     lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {

@@ -245,7 +245,7 @@ template <class T> irradiance_texel_moments make_irradiance_texel_moments(const 
 /// header): E at every output texel centre from make_irradiance_texel_moments(src, max_face).
 /// Work items are output face rows; the result does not depend on the executor.
 /// Throws std::invalid_argument for size < 1 or max_face < 1.
-template <class T, class Executor = serial_executor>
+template <class T, class Executor = thread_executor>
 cubemap<float> irradiance_cubemap_texel_moments(const cubemap<T>& src, int size = 32, int max_face = 32, Executor&& ex = Executor{}) {
     detail::check_arg("irradiance_cubemap_texel_moments", "size", size, 1, limits::max_face_size, "limits::max_face_size");
     detail::check_arg("irradiance_cubemap_texel_moments", "max_face", max_face, 1, limits::max_face_size, "limits::max_face_size");
@@ -289,7 +289,7 @@ template <class T, class Env>
 }
 
 /// Irradiance cubemap (one level, face size opt.size) of an environment: E at every texel centre.
-template <class Env, class Executor = serial_executor>
+template <class Env, class Executor = thread_executor>
 cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt = {}, Executor&& ex = Executor{}) {
     detail::check_arg("irradiance_cubemap", "size", opt.size, 1, limits::max_face_size, "limits::max_face_size");
     if (opt.method == irradiance_method::texel_moments) {
@@ -327,7 +327,7 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
 /// integrator as the specular and sheen chains); another lobe (sampling/lobe.hpp's contract)
 /// gives pi times its weighted mean: a wrapped or rough diffuse kernel runs through it unchanged.
 /// `lobe_roughness` is passed to the lobe (the cosine lobe ignores it). Limits as prefilter.
-template <class Lobe = cosine_lobe, class Env, class Executor = serial_executor>
+template <class Lobe = cosine_lobe, class Env, class Executor = thread_executor>
     requires ld_lobe<Lobe>
 cubemap<float> irradiance_cubemap_lobe(const Env& env, int size, std::uint32_t samples, Executor&& ex = Executor{},
                                        double lobe_roughness = 0.0, double lod_bias = 0.5) {

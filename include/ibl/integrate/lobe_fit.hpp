@@ -400,6 +400,7 @@ struct lobe_taps_lut {
     int taps = 0;
     std::vector<float> data; ///< (j * size + i) * channels + c
     ld_weight weight = ld_weight::n_dot_l;
+    dfg_lut_layout layout{};             ///< which (n.v, r) each texel holds (read by the lookups)
     std::vector<double> level_roughness; ///< empty: taps hold roughness
     double max_l1 = 0.0, mean_l1 = 0.0; ///< of the fits at the texels with r >= 0.05 and A + B > 0
 };
@@ -416,6 +417,7 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
     lut.taps = std::clamp(o.taps, 1, lobe_max_taps);
     lut.channels = 2u + 3u * std::uint32_t(lut.taps);
     lut.weight = w;
+    lut.layout = layout;
     lut.level_roughness = o.level_roughness;
     lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
     const double vmax = o.level_roughness.empty() ? 1.0 : double(o.level_roughness.size() - 1);
@@ -470,6 +472,7 @@ lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, 
     lobe_lut lut;
     lut.size = size;
     lut.weight = w;
+    lut.layout = layout;
     lut.data.assign(std::size_t(size) * size * 4, 0.0f);
     for (std::uint32_t j = 0; j < size; ++j)
         for (std::uint32_t i = 0; i < size; ++i) {

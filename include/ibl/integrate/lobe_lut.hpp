@@ -41,7 +41,7 @@
 #include "../core/vec.hpp"
 #include "../lookup.hpp"
 #include "../sampling/ggx.hpp"
-#include "lookup_error.hpp"
+#include "dfg_lut.hpp"
 #include "prefilter.hpp"
 
 namespace ibl {
@@ -159,10 +159,11 @@ struct lobe_lut {
     std::uint32_t channels = 4;
     std::vector<float> data; ///< (j * size + i) * 4 + c
     ld_weight weight = ld_weight::n_dot_l; ///< the chain kernel r_eff was matched to
+    dfg_lut_layout layout{};               ///< which (n.v, r) each texel holds (read by the lookups)
 };
 
 /// The lobe LUT of model M for a chain baked with weight w (header). A, B from
-/// make_dfg_lut_exact (integrate/lookup_error.hpp) in the same layout. size in [1, 1024].
+/// make_dfg_lut_exact (integrate/dfg_lut.hpp) in the same layout. size in [1, 1024].
 template <class Model = ggx_height_correlated, class Executor = thread_executor>
 lobe_lut make_lobe_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, std::uint32_t nodes = 96,
                        Executor&& ex = Executor{}) {
@@ -172,6 +173,7 @@ lobe_lut make_lobe_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weig
     lobe_lut lut;
     lut.size = size;
     lut.weight = w;
+    lut.layout = layout;
     lut.data.assign(std::size_t(size) * size * 4, 0.0f);
     ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
         for (std::size_t j = begin; j < end; ++j) {

@@ -37,7 +37,7 @@
 // examples/lookup_error.cpp prints that check).
 //
 // DFG (dfg_lookup_error). Over a grid of (n.v, r) points, max and RMS of |A - A_exact| and
-// |B - B_exact| of dfg_lookup(lut, n.v, r, layout) against exact values (dfg_exact_grid: the
+// |B - B_exact| of dfg_lookup(lut, n.v, r) (the table's own layout) against exact values (dfg_exact_grid: the
 // converged quadrature dfg_exact in double), with the location of the largest error.
 //
 // Storage rounding: round_through_half (IEEE binary16, round to nearest even; finite values beyond
@@ -117,48 +117,6 @@ inline dfg_lut quantize_half_lut(const dfg_lut& lut) {
 
 // ---- DFG -------------------------------------------------------------------------------------------
 
-/// The exact table of model M in a layout (ibl/lookup.hpp): texel (i, j) holds the quadrature at
-/// n.v = dfg_texel_value(layout.n_dot_v, i, ...), r = dfg_texel_value(layout.roughness, j, ...).
-/// The uniform layout gives make_dfg_lut_exact(size, ...) of integrate/dfg_lut.hpp bit for bit.
-/// Read it with dfg_lookup(lut, n.v, r, layout) (the lut's own sample() assumes the uniform layout).
-template <class Model, class Executor = thread_executor>
-dfg_lut make_dfg_lut_exact(std::uint32_t size, const dfg_lut_layout& layout, std::uint32_t channels = 3,
-                           dfg_quadrature_nodes nodes = dfg_lut_default_nodes, Executor&& ex = Executor{}) {
-    constexpr std::size_t W = 16;
-    dfg_lut lut{size, channels < 3 ? 2u : 3u, {}};
-    lut.data.assign(std::size_t(size) * size * lut.channels, 0.0f);
-    const dfg_quadrature_rule rule(nodes);
-    const dfg_quadrature_view q = rule.view();
-    auto mu_of = [&](std::uint32_t i) { return dfg_texel_value<double>(layout.n_dot_v, i, size, layout.edge_aligned); };
-    ex(std::size_t(size), [&](std::size_t begin, std::size_t end) {
-        for (std::size_t j = begin; j < end; ++j) {
-            const double r = dfg_texel_value<double>(layout.roughness, std::uint32_t(j), size, layout.edge_aligned);
-            if (r <= 0.0) { // the mirror row of an edge-aligned table: the r -> 0 limit in closed form,
-                            // E = 1 and B = (1 - n.v)^5 (the quadrature degenerates at n.v = r = 0)
-                for (std::uint32_t i = 0; i < size; ++i) {
-                    const double w = pow5(1.0 - mu_of(i));
-                    detail::dfg_store<double>(lut, i, std::uint32_t(j), 1.0, w);
-                }
-                continue;
-            }
-            std::uint32_t i = 0;
-            for (; i + W <= size; i += W) {
-                double mu[W], e[W], b[W];
-                for (std::size_t l = 0; l < W; ++l) mu[l] = mu_of(i + std::uint32_t(l));
-                dfg_quadrature_lanes<Model, W, float>(q, r, mu, e, b);
-                for (std::size_t l = 0; l < W; ++l) detail::dfg_store<double>(lut, i + std::uint32_t(l), std::uint32_t(j), e[l], b[l]);
-            }
-            for (; i < size; ++i) {
-                const double mu = mu_of(i);
-                double e, b;
-                dfg_quadrature_lanes<Model, 1, float>(q, r, &mu, &e, &b);
-                detail::dfg_store<double>(lut, i, std::uint32_t(j), e, b);
-            }
-        }
-    });
-    return lut;
-}
-
 /// A grid of (n.v, r) points: every n.v of one list against every r of another (row-major: r
 /// outer). The default: n.v at 0, 1 and both uniform and quadratic spacing (dense near grazing),
 /// r uniform in [r_min, 1].
@@ -201,9 +159,9 @@ struct dfg_lookup_report {
     std::size_t count = 0;                         ///< points compared
 };
 
-/// Error of dfg_lookup(lut, n.v, r, layout) over the grid against exact values (dfg_exact_grid).
+/// Error of dfg_lookup(lut, n.v, r) (the table's own layout) over the grid against exact values (dfg_exact_grid).
 template <class Table>
-dfg_lookup_report dfg_lookup_error(const Table& lut, const dfg_lut_layout& layout, const dfg_error_grid& g,
+dfg_lookup_report dfg_lookup_error(const Table& lut, const dfg_error_grid& g,
                                    std::span<const vec2<double>> exact) {
     dfg_lookup_report rep;
     const std::size_t nx = g.n_dot_v.size();
@@ -212,7 +170,7 @@ dfg_lookup_report dfg_lookup_error(const Table& lut, const dfg_lut_layout& layou
         for (std::size_t i = 0; i < nx; ++i) {
             const std::size_t k = j * nx + i;
             if (k >= exact.size()) break;
-            const vec3<float> v = dfg_lookup(lut, float(g.n_dot_v[i]), float(g.roughness[j]), layout);
+            const vec3<float> v = dfg_lookup(lut, float(g.n_dot_v[i]), float(g.roughness[j]));
             const double da = std::fabs(double(v.x) - exact[k].x), db = std::fabs(double(v.y) - exact[k].y);
             sq += da * da + db * db;
             rep.max_abs_a = std::fmax(rep.max_abs_a, da);

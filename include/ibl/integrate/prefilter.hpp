@@ -108,9 +108,13 @@ enum class prefilter_method : int {
 };
 
 struct prefilter_options {
-    /// Output levels, clamped to the full chain of base_size (floor(log2 base) + 1). Must be >= 0;
-    /// 0 means the full chain.
-    int levels = 5;
+    /// levels = automatic (the default, ibl-bake's rule): floor(log2 base) - 1 clamped to [2, 6]
+    /// and to the full chain (256 -> 6 levels, 256..8; the smallest face >= 4 for base >= 16; at
+    /// least one rough level besides the mirror level 0 wherever the base has a mip).
+    static constexpr int automatic = -1;
+    /// Output levels, clamped to the full chain of base_size (floor(log2 base) + 1); 0 means the
+    /// full chain, automatic (-1) the rule above. Other negative values throw.
+    int levels = automatic;
     /// Face size of output level 0; 0 = the source's (cubemaps only: other sources need a size).
     int base_size = 0;
     roughness_mip_policy policy{};
@@ -239,11 +243,24 @@ std::vector<vec3<float>> prefilter_base(const Env& env, int n, Executor& ex) {
 }
 } // namespace detail
 
+/// The automatic level count of a base face size (prefilter_options::automatic): floor(log2 base)
+/// - 1 clamped to [2, 6], at most the full chain floor(log2 base) + 1.
+inline int prefilter_auto_levels(int base_size) {
+    int log2n = 0;
+    while ((base_size >> (log2n + 1)) > 0) ++log2n;
+    const int full = log2n + 1;
+    const int l = std::clamp(log2n - 1, 2, 6);
+    return std::min(l, full);
+}
+
 /// Number of levels the options give for a base face size.
 inline int prefilter_levels(const prefilter_options& opt, int base_size) {
     int full = 1;
     while ((base_size >> full) > 0) ++full;
-    if (opt.levels < 0) throw std::invalid_argument("ibl::prefilter: levels must be >= 0, got " + std::to_string(opt.levels));
+    if (opt.levels == prefilter_options::automatic) return prefilter_auto_levels(base_size);
+    if (opt.levels < 0)
+        throw std::invalid_argument("ibl::prefilter: levels must be >= 0 or prefilter_options::automatic, got " +
+                                    std::to_string(opt.levels));
     return opt.levels == 0 ? full : std::min(opt.levels, full);
 }
 
@@ -284,7 +301,7 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 /// std::length_error for base_size > limits::max_face_size, a level's samples (opt.samples or
 /// samples_per_level[l]) > limits::max_samples, or a total work sum over levels of
 /// 6 n_l^2 samples_l (x 2 when trilinear) > limits::max_work, before any work.
-template <class Lobe = ggx_lobe, class Env, class Executor = serial_executor>
+template <class Lobe = ggx_lobe, class Env, class Executor = thread_executor>
     requires ld_lobe<Lobe>
 cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     const int base = detail::prefilter_base_size(env, opt.base_size);

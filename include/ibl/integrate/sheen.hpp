@@ -199,7 +199,7 @@ dfg_lut make_sheen_lut(std::uint32_t size, sheen_quadrature_nodes nodes = sheen_
 }
 
 /// The Charlie-prefiltered chain: prefilter<charlie_lobe>(env, opt, ex).
-template <class Env, class Executor = serial_executor>
+template <class Env, class Executor = thread_executor>
 cubemap<float> prefilter_sheen(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     return prefilter<charlie_lobe>(env, opt, ex);
 }

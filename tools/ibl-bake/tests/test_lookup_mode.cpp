@@ -25,6 +25,7 @@
 #include <fstream>
 #include <iterator>
 #include <sstream>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -58,9 +59,17 @@ ibl::cubemap<float> load_chain(const std::string& path) {
         decode_ktx2_cubemap(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(b.data()), b.size())));
 }
 
+/// The layout a table file records (ibl.dfg_layout).
+ibl::dfg_lut_layout layout_of(const std::string& path) {
+    for (const auto& [k, v] : read_exr_string_attributes(path))
+        if (k == "ibl.dfg_layout") return ibl::parse_dfg_lut_layout(v);
+    FAIL("no ibl.dfg_layout in " << path);
+    return {};
+}
+
 ibl::dfg_lut load_lut(const std::string& path) {
     const image_rgb32f img = read_image(path);
-    ibl::dfg_lut lut{std::uint32_t(img.width), 3, {}};
+    ibl::dfg_lut lut{std::uint32_t(img.width), 3, {}, layout_of(path)};
     for (int j = 0; j < img.height; ++j)
         for (int i = 0; i < img.width; ++i)
             for (int c = 0; c < 3; ++c) lut.data.push_back(img.texel(i, j)[c]);
@@ -72,15 +81,15 @@ ibl::lobe_lut load_lobe(const std::string& path) {
     ibl::lobe_lut lut;
     lut.size = std::uint32_t(img.width);
     lut.data = img.rgba;
+    lut.layout = layout_of(path);
     return lut;
 }
 
 /// LD of the lobe model at (n, v, r): ibl::specular_lobe with F0 = F90 = 1 gives LD (A + B).
 dvec3 lobe_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const dvec3& n, const dvec3& v, double r) {
-    const ibl::dfg_lut_layout layout{};
     const fvec3 fn(n), fv(v);
-    const ibl::vec4<float> p = ibl::lobe_lut_lookup(lobe, ibl::saturate(glm::dot(fn, fv)), float(r), layout);
-    const fvec3 e = ibl::specular_lobe(chain, ibl::specular_lookup_desc{}, lobe, layout, fn, fv, float(r), fvec3(1.0f), fvec3(1.0f));
+    const ibl::vec4<float> p = ibl::lobe_lut_lookup(lobe, ibl::saturate(glm::dot(fn, fv)), float(r));
+    const fvec3 e = ibl::specular_lobe(chain, ibl::specular_lookup_desc::accurate(), lobe, fn, fv, float(r), fvec3(1.0f), fvec3(1.0f));
     return dvec3(e) / double(ibl::saturate(p.x) + ibl::saturate(p.y));
 }
 
@@ -92,6 +101,7 @@ ibl::lobe_taps_lut load_taps(const std::string& a_path, const std::string& b_pat
     lut.size = std::uint32_t(a.width);
     lut.taps = 2;
     lut.channels = 8;
+    lut.layout = layout_of(a_path);
     for (std::size_t k = 0; k < std::size_t(lut.size) * lut.size; ++k) {
         for (std::size_t c = 0; c < 4; ++c) lut.data.push_back(a.rgba[4 * k + c]);
         for (std::size_t c = 0; c < 4; ++c) lut.data.push_back(b.rgba[4 * k + c]);
@@ -101,7 +111,7 @@ ibl::lobe_taps_lut load_taps(const std::string& a_path, const std::string& b_pat
 
 /// The table's 8 channels at (n.v, r): one bilinear read in the DFG layout.
 std::vector<double> taps_read(const ibl::lobe_taps_lut& t, double n_dot_v, double r) {
-    const ibl::vec2<float> st = ibl::dfg_lut_coord(float(n_dot_v), float(r), t.size, ibl::dfg_lut_layout{});
+    const ibl::vec2<float> st = ibl::dfg_lut_coord(float(n_dot_v), float(r), t.size, t.layout);
     float p[8] = {};
     ibl::detail::table_bilinear(t, st.x, st.y, p, 8);
     return std::vector<double>(p, p + 8);
@@ -111,7 +121,7 @@ std::vector<double> taps_read(const ibl::lobe_taps_lut& t, double n_dot_v, doubl
 dvec3 taps_ld(const ibl::cubemap<float>& chain, const ibl::lobe_taps_lut& t, const dvec3& n, const dvec3& v, double r) {
     const fvec3 fn(n), fv(v);
     const std::vector<double> p = taps_read(t, ibl::saturate(glm::dot(fn, fv)), r);
-    const fvec3 e = ibl::specular_lobe_taps(chain, ibl::specular_lookup_desc{}, t, ibl::dfg_lut_layout{}, fn, fv, float(r),
+    const fvec3 e = ibl::specular_lobe_taps(chain, ibl::specular_lookup_desc::accurate(), t, fn, fv, float(r),
                                             fvec3(1.0f), fvec3(1.0f));
     return dvec3(e) / double(ibl::saturate(float(p[0])) + ibl::saturate(float(p[1])));
 }
@@ -160,14 +170,13 @@ void check_answers(const std::string& text, const std::vector<std::vector<double
 TEST_CASE("lookup: answers equal the library's runtime functions on the bake's files") {
     scratch s("ibl_bake_lookup_tests");
     // SH diffuse and no extracted sun here; the next case checks the default (map + sun) answers.
-    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --out " + (s / "bake") +
+    REQUIRE(shell(tool + " --quiet --preset accurate --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --out " + (s / "bake") +
                " >/dev/null 2>&1") == 0);
     const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
     const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
     const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
     const ibl::lobe_lut lobe = load_lobe(s / "bake/lobe_lut.exr"); // the default runtime model
-    const ibl::specular_lookup_desc sd{};
-    const ibl::dfg_lut_layout layout{};
+    const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
 
     std::vector<std::string> q;
     std::vector<std::vector<double>> want;
@@ -182,7 +191,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         want.push_back({ld.x, ld.y, ld.z});
         std::snprintf(buf, sizeof buf, "dfg %.17g %.17g", nv, r);
         q.push_back(buf);
-        const fvec3 ab = ibl::dfg_lookup(lut, float(nv), float(r), layout);
+        const fvec3 ab = ibl::dfg_lookup(lut, float(nv), float(r));
         want.push_back({ab.x, ab.y});
         std::snprintf(buf, sizeof buf, "irradiance %.17g %.17g %.17g", d.x, d.y, d.z);
         q.push_back(buf);
@@ -199,7 +208,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         m.base_color = dvec3(0.9, 0.6, 0.5);
         ibl::ibl_sample<double> smp;
         const double ndv = std::clamp(glm::dot(d, v), 0.0, 1.0);
-        const ibl::vec4<float> pv = ibl::lobe_lut_lookup(lobe, float(ndv), float(r), layout);
+        const ibl::vec4<float> pv = ibl::lobe_lut_lookup(lobe, float(ndv), float(r));
         smp.ld = lobe_ld(chain, lobe, d, v, r);
         smp.dfg = ibl::vec2<double>(pv.x, pv.y);
         smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, d), dvec3(0.0));
@@ -207,7 +216,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         want.push_back({lo.x, lo.y, lo.z});
         std::snprintf(buf, sizeof buf, "lobe %.17g %.17g", nv, r);
         q.push_back(buf);
-        const ibl::vec4<float> pl = ibl::lobe_lut_lookup(lobe, float(nv), float(r), layout);
+        const ibl::vec4<float> pl = ibl::lobe_lut_lookup(lobe, float(nv), float(r));
         want.push_back({pl.x, pl.y, pl.z, pl.w});
     }
     std::ofstream(s / "queries.txt") << "# a comment\n\n" << [&] {
@@ -252,7 +261,7 @@ TEST_CASE("lookup: a split-sum bake shades with LD(R, r) and the DFG table, and 
         const double ndv = std::clamp(glm::dot(n, v), 0.0, 1.0);
         ibl::ibl_sample<double> smp;
         smp.ld = dvec3(ibl::specular_lookup(chain, fvec3(2.0 * glm::dot(n, v) * n - v), float(r)));
-        const fvec3 ab = ibl::dfg_lookup(lut, float(ndv), float(r), ibl::dfg_lut_layout{});
+        const fvec3 ab = ibl::dfg_lookup(lut, float(ndv), float(r));
         smp.dfg = ibl::vec2<double>(ab.x, ab.y);
         smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, n), dvec3(0.0));
         const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
@@ -268,7 +277,7 @@ TEST_CASE("lookup: a split-sum bake shades with LD(R, r) and the DFG table, and 
 
 TEST_CASE("lookup: a taps2 bake shades with ibl::specular_lobe_taps and answers taps from its two files") {
     scratch s("ibl_bake_lookup_taps");
-    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --runtime taps2 --out " +
+    REQUIRE(shell(tool + " --quiet --preset accurate --size 16 --lut-size 16 --quality low --extract-sun off --irradiance-size 0 --runtime taps2 --out " +
                   (s / "bake") + " >/dev/null 2>&1") == 0);
     CHECK_FALSE(fs::exists(s / "bake/lobe_lut.exr"));
     const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
@@ -305,15 +314,15 @@ TEST_CASE("lookup: a taps2 bake shades with ibl::specular_lobe_taps and answers 
     std::ofstream(s / "q2.txt") << "lobe 0.5 0.5\n";
     CHECK(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
     CHECK(slurp(s / "a2.txt").find("no lobe LUT") != std::string::npos);
-    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --extract-sun off --out " + (s / "lobe") + " >/dev/null 2>&1") == 0);
+    REQUIRE(shell(tool + " --quiet --preset accurate --size 16 --lut-size 16 --quality low --extract-sun off --out " + (s / "lobe") + " >/dev/null 2>&1") == 0);
     std::ofstream(s / "q3.txt") << "taps 0.5 0.5\n";
     CHECK(shell(tool + " --lookup " + (s / "lobe") + " < " + (s / "q3.txt") + " > " + (s / "a3.txt")) == 1);
     CHECK(slurp(s / "a3.txt").find("bake with --runtime taps2") != std::string::npos);
 }
 
-TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers are about the whole environment") {
+TEST_CASE("lookup: with the accurate bake (irradiance map, extracted sun) answers are about the whole environment") {
     scratch s("ibl_bake_lookup_tests");
-    REQUIRE(shell(tool + " --quiet --size 32 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
+    REQUIRE(shell(tool + " --quiet --preset accurate --size 32 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
     const ibl_examples::json_value lights = ibl_examples::parse_json(slurp(s / "bake/lights.json"));
     const auto& list = lights.find("lights")->values;
     REQUIRE(list.size() == 1); // the built-in sky's sun
@@ -334,7 +343,8 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
             std::snprintf(buf, sizeof buf, "specular %.17g %.17g %.17g %.17g\nirradiance %.17g %.17g %.17g\n", d.x, d.y, d.z, r, d.x, d.y, d.z);
             q += buf;
             // the chain is G1-weighted: the sun's term of the same weight (the tool's 8 nodes)
-            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r))) + ibl::disk_light_ld(sun, d, r, 8, ibl::ld_weight::g1);
+            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r), ibl::specular_lookup_desc::accurate())) +
+                             ibl::disk_light_ld(sun, d, r, 8, ibl::ld_weight::g1);
             const dvec3 e = dvec3(map.radiance(fvec3(d), 0.0f)) + ibl::disk_light_irradiance(d, sun);
             want.push_back({ld.x, ld.y, ld.z});
             want.push_back({e.x, e.y, e.z});
@@ -342,6 +352,44 @@ TEST_CASE("lookup: with the default bake (irradiance map, extracted sun) answers
     std::ofstream(s / "q.txt") << q;
     REQUIRE(shell(tool + " --lookup " + (s / "bake") + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
     check_answers(slurp(s / "a.txt"), want);
+}
+
+TEST_CASE("defaults: the default bake is the textbook products, whole, and every file says so") {
+    scratch s("ibl_bake_lookup_defaults");
+    REQUIRE(shell(tool + " --quiet --size 16 --lut-size 16 --quality low --out " + (s / "bake") + " >/dev/null 2>&1") == 0);
+    CHECK_FALSE(std::filesystem::exists(s / "bake/lights.json")); // nothing taken out of the environment
+    CHECK_FALSE(std::filesystem::exists(s / "bake/lobe_lut.exr"));
+    auto attrs = [](const std::string& path) {
+        std::map<std::string, std::string> m;
+        for (const auto& [k, v] : read_exr_string_attributes(path)) m[k] = v;
+        return m;
+    };
+    const auto dfg = attrs(s / "bake/dfg.exr");
+    CHECK(dfg.at("ibl.dfg_layout") == "uniform");
+    CHECK(dfg.at("ibl.dfg_channels") == "A, B, k");
+    CHECK(dfg.at("ibl.model") == "ggx_height_correlated");
+    CHECK(dfg.at("ibl.preset") == "default");
+    CHECK(dfg.at("ibl.sun_extracted").rfind("no", 0) == 0);
+    const auto l1 = attrs(s / "bake/specular_l1_px.exr");
+    CHECK(l1.at("ibl.ld_weight") == "nl");
+    CHECK(l1.at("ibl.specular_lookup") == "textbook");
+    CHECK(l1.at("ibl.level") == "1");
+    CHECK(l1.at("ibl.runtime") == "split-sum");
+    CHECK(l1.at("ibl.sun_extracted").rfind("no", 0) == 0);
+    CHECK(attrs(s / "bake/irradiance_py.exr").count("ibl.conventions") == 1);
+    const ibl_examples::json_value sh = ibl_examples::parse_json(slurp(s / "bake/sh.json"));
+    REQUIRE(sh.find("conventions") != nullptr);
+    CHECK(sh.find("conventions")->find("ibl.preset")->string == "default");
+    // The textbook table answers texture(lut, vec2(n.v, r)): texel (i, j) at ((i + 0.5) / N, (j + 0.5) / N).
+    const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
+    const ibl::vec2<double> e = ibl::dfg_exact<ibl::ggx_height_correlated>(lut.n_dot_v(5), lut.roughness(9));
+    CHECK(double(lut.at(5, 9, 0)) == doctest::Approx(e.x).epsilon(1e-4));
+    CHECK(double(lut.at(5, 9, 1)) == doctest::Approx(e.y).scale(1).epsilon(1e-4));
+    // A table of another layout copied into the folder is refused.
+    REQUIRE(shell(tool + " --quiet --preset accurate --size 16 --lut-size 16 --quality low --out " + (s / "acc") + " >/dev/null 2>&1") == 0);
+    std::filesystem::copy_file(s / "acc/dfg.exr", s / "bake/dfg.exr", std::filesystem::copy_options::overwrite_existing);
+    CHECK(shell(tool + " --lookup " + (s / "bake") + " < /dev/null > /dev/null 2> " + (s / "err.txt")) == 1);
+    CHECK(slurp(s / "err.txt").find("remapped layout, report.json says uniform") != std::string::npos);
 }
 
 TEST_CASE("lookup: sheen and dfg_sheen answer from the sheen chain and table") {

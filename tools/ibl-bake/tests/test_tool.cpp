@@ -229,11 +229,13 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     const json sh = parse_json(slurp(out + "/sh.json"));
     CHECK(sh["bands"].number == 3);
     CHECK(is_triples(sh["radiance"], 9));
-    CHECK(is_triples(sh["irradiance"], 9));
     CHECK(sh["convention"].str.find("+Y up") != std::string::npos);
     CHECK(sh["window"]["applied"].kind == json::bool_v);
-    CHECK_FALSE(sh["window"]["applied"].boolean); // the sun is extracted (lights.json): the residual does not ring
-    CHECK(slurp(out + "/lights.json").find("\"type\": \"sun\"") != std::string::npos);
+    // the default keeps the sun in every product: 3-band SH of the sky + sun rings negative, the
+    // automatic window keeps E >= 0
+    CHECK(sh["window"]["applied"].boolean);
+    CHECK(is_triples(sh["irradiance_windowed"], 9));
+    CHECK_FALSE(fs::exists(out + "/lights.json"));
     for (const auto& f : faces) CHECK(read_image(out + "/irradiance_" + f + ".exr").width == 32);
     CHECK(sh["window"]["min_irradiance_before"].items.size() == 3);
 
@@ -253,7 +255,36 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     CHECK(rep["sh"]["check"]["max_rel"].kind == json::number_v);
     CHECK(rep["dfg"]["check"]["max_abs"].number < 1e-2);
     CHECK(rep["split_sum"]["materials"].items.size() == 6);
-    // the default runtime model: the lobe LUT of a G1 chain, both models measured
+    // the default runtime model: the split sum of an n.l chain, no lobe table
+    CHECK(rep["split_sum"]["runtime_model"].str == "split-sum");
+    CHECK(rep["plan"]["runtime"]["runtime_model"]["name"].str == "split-sum");
+    CHECK(rep["plan"]["runtime"]["ld_weight"]["name"].str == "nl");
+    CHECK_FALSE(fs::exists(out + "/lobe_lut.exr"));
+    CHECK_FALSE(rep.has("lobe_lut"));
+    const std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
+    CHECK(kv.at("ibl.ld_weight") == "nl");
+    CHECK(kv.at("ibl.runtime") == "split-sum");
+    CHECK(kv.at("ibl.specular_lookup") == "textbook");
+    CHECK(kv.at("ibl.preset") == "default");
+    CHECK(kv.at("ibl.sun_extracted").rfind("no", 0) == 0);
+    CHECK_FALSE(fs::exists(out + "/lobe_taps_a.exr")); // the two-tap table only with --runtime taps2
+    CHECK_FALSE(rep.has("lobe_taps"));
+    // nothing else in the parent: the staging directory is gone
+    CHECK(entries(s.path) == std::set<std::string>{"bake", "stderr.txt", "stdout.txt"});
+}
+
+TEST_CASE("full run: --preset accurate writes the lobe LUT of a G1 chain and extracts the sun") {
+    scratch_dir s("accurate");
+    const std::string out = s / "bake";
+    const run_result r = run(s, with(tiny, {"--preset", "accurate", "--threads", "2", "--out", out}));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    const json sh = parse_json(slurp(out + "/sh.json"));
+    CHECK(is_triples(sh["irradiance"], 9));
+    CHECK_FALSE(sh["window"]["applied"].boolean); // the sun is extracted (lights.json): the residual does not ring
+    CHECK(slurp(out + "/lights.json").find("\"type\": \"sun\"") != std::string::npos);
+    const json rep = parse_json(slurp(out + "/report.json"));
+    // the runtime model: the lobe LUT of a G1 chain, both models measured
     CHECK(r.out.find("lobe lut metal r=0.9") != std::string::npos);
     CHECK(rep["split_sum"]["runtime_model"].str == "lobe");
     CHECK(rep["split_sum"]["materials_split_sum"].items.size() == 6);
@@ -269,19 +300,21 @@ TEST_CASE("full run: every file, sizes, KTX2 header, sh.json and report.json") {
     CHECK(lobe.rgba[2] == 1.0f); // row 0 = r = 0 (edge-aligned): the mirror, s = 1, r_eff = 0
     CHECK(lobe.rgba[3] == 0.0f);
     CHECK(slurp(out + "/lobe_lut.hpp").find("lobe_lut_size = 16;") != std::string::npos);
+    const std::string ktx = slurp(out + "/specular.ktx2");
+    const ktx2_info info = parse_ktx2(std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(ktx.data()), ktx.size()));
     const std::map<std::string, std::string> kv(info.key_values.begin(), info.key_values.end());
     CHECK(kv.at("ibl.ld_weight") == "g1");
     CHECK(kv.at("ibl.runtime") == "lobe");
-    CHECK_FALSE(fs::exists(out + "/lobe_taps_a.exr")); // the two-tap table only with --runtime taps2
-    CHECK_FALSE(rep.has("lobe_taps"));
-    // nothing else in the parent: the staging directory is gone
-    CHECK(entries(s.path) == std::set<std::string>{"bake", "stderr.txt", "stdout.txt"});
+    CHECK(kv.at("ibl.preset") == "accurate");
+    CHECK(kv.at("ibl.sun_extracted").rfind("yes", 0) == 0);
+    CHECK(kv.at("ibl.specular_lookup") == "accurate");
+    CHECK_FALSE(fs::exists(out + "/lobe_taps_a.exr"));
 }
 
 TEST_CASE("full run: --runtime taps2 writes the two-tap table and measures its model") {
     scratch_dir s("taps2");
     const std::string out = s / "bake";
-    const run_result r = run(s, with(tiny, {"--runtime", "taps2", "--out", out}));
+    const run_result r = run(s, with(tiny, {"--preset", "accurate", "--runtime", "taps2", "--out", out}));
     INFO(r.err);
     REQUIRE(r.status == 0);
     CHECK(r.out.find("lobe taps") != std::string::npos);
@@ -353,7 +386,7 @@ TEST_CASE("deterministic: bit-identical outputs with 1 and 2 threads") {
         CHECK(slurp(a + "/" + f) == slurp(b + "/" + f));
         ++compared;
     }
-    CHECK(compared == 18 + 5 + 8 + 2); // + irradiance_{face}.exr, irradiance.ktx2, lights.json, lobe_lut.{exr,hpp}
+    CHECK(compared == 18 + 5 + 7); // + irradiance_{face}.exr, irradiance.ktx2
 }
 
 TEST_CASE("bad options: exit 2 with a message, nothing created") {
