@@ -143,7 +143,7 @@ TEST_CASE("scene: the targets are checked by default and reported") {
     REQUIRE(r.status == 0);
     CHECK(r.out.find("scene targets") != std::string::npos);
     CHECK(r.out.find("specular  target 0.2") != std::string::npos);
-    CHECK(r.out.find("diffuse   target 0.35") != std::string::npos);
+    CHECK(r.out.find("diffuse   target 0.5") != std::string::npos);
     const std::string report = slurp(s / "out/report.json");
     CHECK(report.find("\"target_check\"") != std::string::npos);
     CHECK(report.find("\"product\": \"specular\"") != std::string::npos);
