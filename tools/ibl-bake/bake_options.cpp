@@ -113,6 +113,7 @@ const std::map<std::string, option_spec>& option_table() {
         {"--mirror", {false, [](bake_options& o, const std::string&) { o.mirror = true; }}},
         {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
         {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
+        {"--strict", {false, [](bake_options& o, const std::string&) { o.strict = true; }}},
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
@@ -180,6 +181,7 @@ void check_combination(const bake_options& o, bool have_out) {
     }
     if (!have_out) throw usage_error("--out DIR is required");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
+    if (o.strict && o.scene.empty()) throw usage_error("--strict needs --scene");
     if (o.levels > 0) {
         int full = 1;
         while ((o.size >> full) > 0) ++full;
@@ -256,6 +258,7 @@ std::string usage_text() {
            "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R, taps NV R\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
+           "  --strict           with --scene: a missed error target is an error (exit 1, DIR untouched)\n"
            "  --help, --version\n";
 }
 

@@ -40,6 +40,7 @@
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
+//   --strict            with --scene: a missed error target is an error (exit 1, DIR untouched)
 //   --help, --version
 // Values may be given as "--size 32" or "--size=32". Numbers must be plain decimal integers.
 
@@ -92,6 +93,7 @@ struct bake_options {
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)
+    bool strict = false;       ///< --strict (with --scene): a missed error target fails the bake
 };
 
 /// Cost knobs of one quality preset (docs/ibl-bake.md has the table).

@@ -3,7 +3,9 @@
 
 #include "pipeline.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <stdexcept>
 #include <cstring>
 
 #include <unistd.h>
@@ -31,6 +33,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     s.push_back(make_lookup_stage());
     s.push_back(make_split_sum_stage());
     s.push_back(make_preview_stage());
+    s.push_back(make_target_check_stage());
     s.push_back(make_compare_full_stage());
     return s;
 }
@@ -70,6 +73,18 @@ void report_options(json_writer& j, const bake_context& ctx) {
     j.key("quality").value(ctx.qs.name);
     j.key("threads").value(ctx.ex.threads());
     j.key("ktx2_format").value(o.ktx2_f32 ? "rgba32f" : "rgba16f");
+    j.end_object();
+    // the sizes baked (a scene's plan may use less than --size and --lut-size); level 0 = the mirror level
+    const ibl::specular_plan& sp = ctx.plan.specular;
+    j.key("baked_sizes").begin_object();
+    j.key("face_size").value(std::max(1, sp.virtual_base_size >> sp.first_level));
+    j.key("virtual_base_size").value(sp.virtual_base_size);
+    j.key("stored_levels").value(int(sp.levels.size()));
+    j.key("first_level").value(sp.first_level);
+    j.key("last_level").value(sp.first_level + int(sp.levels.size()) - 1);
+    j.key("virtual_levels").value(sp.virtual_levels);
+    j.key("source_size").value(ctx.plan.source_size);
+    j.key("lut_size").value(ctx.plan.dfg.size);
     j.end_object();
 }
 
@@ -117,9 +132,17 @@ void write_outputs(const bake_context& ctx, const std::vector<std::unique_ptr<st
 
 void print_report(std::FILE* out, const bake_context& ctx, const std::vector<std::unique_ptr<stage>>& stages,
                   std::size_t files, double total_ms) {
-    std::fprintf(out, "ibl-bake %s: %s -> %s (%s: size %d, %d levels, LUT %d, quality %s, %u threads)\n\n",
-                 version_string().c_str(), ctx.src.name.c_str(), ctx.opt.out.c_str(), ctx.scene_mode ? "scene plan" : "full bake",
-                 ctx.opt.size, ctx.set.levels, ctx.opt.lut_size, ctx.qs.name, ctx.ex.threads());
+    // the sizes the plan bakes (a scene's are at most --size / --levels / --lut-size); level 0 = the mirror level
+    const ibl::specular_plan& sp = ctx.plan.specular;
+    const int stored = int(sp.levels.size());
+    const std::string levels = ctx.scene_mode ? std::to_string(stored) + " levels (" + std::to_string(sp.first_level) + ".." +
+                                                    std::to_string(sp.first_level + stored - 1) + " of 0.." +
+                                                    std::to_string(sp.virtual_levels - 1) + ")"
+                                              : std::to_string(stored) + " levels";
+    std::fprintf(out, "ibl-bake %s: %s -> %s (%s: size %d, %s, LUT %d, quality %s, %u threads)\n\n", version_string().c_str(),
+                 ctx.src.name.c_str(), ctx.opt.out.c_str(), ctx.scene_mode ? "scene plan" : "full bake",
+                 std::max(1, sp.virtual_base_size >> sp.first_level), levels.c_str(), ctx.plan.dfg.size, ctx.qs.name,
+                 ctx.ex.threads());
     std::vector<table_row> rows;
     for (const auto& s : stages) {
         for (const auto& line : s->notes_before()) std::fprintf(out, "%s\n", line.c_str());
@@ -144,6 +167,12 @@ void run_bake(const bake_options& opt, std::FILE* out) {
     check_output_dir(opt.out);
     bake_context ctx{opt, settings_for(opt.q), prog, ex};
     const std::vector<std::unique_ptr<stage>> stages = run_stages(ctx);
+    if (opt.strict && !ctx.target_misses.empty()) { // nothing is staged yet: DIR stays as it was
+        std::string what;
+        for (const auto& m : ctx.target_misses) what += (what.empty() ? "" : "; ") + m;
+        throw std::runtime_error("--strict: " + what + " (nothing written)");
+    }
+    for (const auto& m : ctx.target_misses) std::fprintf(stderr, "ibl-bake: warning: %s\n", m.c_str());
     std::vector<std::string> names;
     write_outputs(ctx, stages, names, t_total);
     const double total_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t_total).count();

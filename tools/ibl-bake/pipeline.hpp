@@ -130,6 +130,9 @@ struct bake_context {
     std::optional<ibl::lobe_taps_lut> taps; ///< the two-tap table (--runtime taps2)
     diffuse_data diffuse;
     product_times measured; ///< filled by the pipeline after each product stage
+
+    // the scene's targets (the target_check stage): one line per missed target
+    std::vector<std::string> target_misses;
 };
 
 /// A file a stage writes: its name in DIR and the function writing it to a path.

@@ -33,14 +33,6 @@ namespace ibl_bake {
 
 namespace {
 
-struct shading_point {
-    dvec3 n, v;
-    std::size_t normal_index;
-};
-struct material_sample {
-    std::string name;
-    ibl::pbr_material<double> m;
-};
 struct shade_error {
     double rel_rms = 0.0, max_rel = 0.0;
     std::size_t points = 0;
@@ -63,38 +55,19 @@ struct converged_set {
     product_view view;
 };
 
-ibl::pbr_material<double> scene_material(double metallic, double roughness) {
-    ibl::pbr_material<double> pm;
-    pm.metallic = std::clamp(metallic, 0.0, 1.0);
-    pm.base_color = pm.metallic > 0.5 ? dvec3(0.95, 0.64, 0.54) : dvec3(0.8);
-    pm.roughness = std::clamp(roughness, 0.0, 1.0);
-    return pm;
-}
-
-std::vector<material_sample> scene_materials(const ibl::scene_description& scene) {
-    std::vector<material_sample> mats;
-    for (const auto& m : scene.materials)
-        for (const auto& r : m.roughness)
-            for (double x : {r.lo, 0.5 * (r.lo + r.hi), r.hi}) {
-                const ibl::pbr_material<double> pm = scene_material(m.metallic, x);
-                if (!mats.empty() && mats.back().name == m.name && mats.back().m.roughness == pm.roughness) continue;
-                mats.push_back({m.name, pm});
-            }
-    return mats;
-}
-
 /// Relative RMS and largest relative difference of ambient luminance: `a` against the converged
 /// set (whose irradiance is the brute-force value at the point's normal when `diffuse_lit`).
-shade_error compare_shading(const std::vector<material_sample>& mats, const std::vector<shading_point>& pts,
+shade_error compare_shading(const std::vector<scene_shading_material>& mats, const std::vector<scene_shading_point>& pts,
                             const product_view& a, const converged_set& c, bool diffuse_lit, bool multiscatter) {
     double num = 0.0, den = 0.0;
     shade_error e;
     for (const auto& ms : mats) {
         const auto shader = ibl::pbr_shader<double>::from(ms.m, multiscatter);
-        for (const auto& p : pts) {
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const scene_shading_point& p = pts[i];
             const double nv = std::clamp(glm::dot(p.n, p.v), 0.0, 1.0);
             ibl::ibl_sample<double> sr = c.view.sample(p.n, p.v, ms.m.roughness);
-            sr.irradiance_over_pi = diffuse_lit ? c.e_brute[p.normal_index] / ibl::pi_v<double> : dvec3(0.0);
+            sr.irradiance_over_pi = diffuse_lit ? c.e_brute[i] / ibl::pi_v<double> : dvec3(0.0);
             const double ya = ibl::luminance(shader.ambient(nv, a.sample(p.n, p.v, ms.m.roughness)));
             const double yr = ibl::luminance(shader.ambient(nv, sr));
             num += (ya - yr) * (ya - yr);
@@ -179,9 +152,7 @@ void compare_full_stage::bake_converged(bake_context& ctx) {
         if (l.level > 0) l.samples = 4096;
     }
     conv_.chain = bake_chain(fsource_, cp, ld_weight_named(ctx.opt.ld_weight), ctx.ex);
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < 3; ++y)
-            for (int x = 0; x < 3; ++x) conv_.normals.push_back(ibl::cube_texel_direction<double>(f, x, y, 3));
+    for (const auto& p : scene_shading_points()) conv_.normals.push_back(p.n);
     conv_.e_brute = texel_sum_irradiance(fsource_, level_at_most(fsource_, 64), conv_.normals, ctx.ex);
     conv_.view = {&conv_.chain, ctx.set.policy, ctx.set.levels, ctx.plan.specular.first_level, nullptr, nullptr};
     converged_ms_ = ms_since(t0);
@@ -189,12 +160,8 @@ void compare_full_stage::bake_converged(bake_context& ctx) {
 }
 
 void compare_full_stage::shade(const bake_context& ctx) {
-    std::vector<shading_point> pts;
-    for (std::size_t i = 0; i < conv_.normals.size(); ++i) {
-        const ibl::frame<double> fr = ibl::make_frame(conv_.normals[i]);
-        pts.push_back({conv_.normals[i], glm::normalize(conv_.normals[i] + fr.t), i});
-    }
-    const std::vector<material_sample> mats = scene_materials(ctx.scene);
+    const std::vector<scene_shading_point> pts = scene_shading_points();
+    const std::vector<scene_shading_material> mats = scene_shading_materials(ctx.scene);
     product_view planned = baked_view(ctx).split_sum(); // the plan's products, read as the full bake's are
     if (!diffuse_lit_) planned.diffuse = nullptr;
     const product_view full{&fchain_, ctx.set.policy, ctx.set.levels, 0, &*flut_, diffuse_lit_ ? &fdiffuse_ : nullptr};

@@ -4,9 +4,11 @@
 //               "radiance" is always the raw projection. A window (--sh-window) applies to the
 //               irradiance and shader coefficients only, which are then named *_windowed:
 //               auto (default): the weakest Hanning window keeping E >= 0 (ibl::sh_auto_window)
-//               when the raw irradiance's minimum is below -window_threshold (5%) of its mean in
-//               some channel (a negative minimum that matters; a ringing of 1-2% of the mean is
-//               left alone, as the shader clamps E at 0); none; or a Hanning width W.
+//               whenever the raw irradiance's minimum is negative in some channel, however little
+//               (so the product never holds negative light); if no window can (a channel whose
+//               mean radiance is negative), that channel's coefficients are clamped to 0 (E = 0
+//               there); none; or a Hanning width W. The report gives the window or clamp and the
+//               minimum E before and after.
 //   irradiance  an irradiance cubemap of face --irradiance-size (default 32; a scene plan's map size)
 //               by texel moments over level 0 (ibl::irradiance_texel_moments: exact for blocks
 //               above the horizon). In the full bake beside SH; the runtime's diffuse product.
@@ -83,8 +85,6 @@ const char* sh_convention =
     "for the first 9 (the higher bands' polynomials as basis.hpp; windowed: 'irradiance_over_pi_shader_windowed') "
     "(multiply by the diffuse albedo for Lambert).";
 
-constexpr double window_threshold = 0.05; ///< auto window: min E below -5% of the mean E
-
 /// The runtime's E against brute force over the whole source, when a sun was extracted.
 void check_with_sun(const bake_context& ctx, const std::vector<dvec3>& normals, irradiance_check& c,
                     const std::function<dvec3(const dvec3&)>& e_product, double& mean, double& max) {
@@ -131,7 +131,8 @@ public:
 
     std::vector<table_row> rows() const override {
         const std::string method = std::to_string(bands_) + "-band projection, " +
-                                   (windowed_ ? fmt("Hanning window W=%.3g", width_) : std::string("no window"));
+                                   (windowed_ ? fmt("Hanning window W=%.3g", width_) : std::string("no window")) +
+                                   (clamped_ ? ", negative channels clamped" : "");
         std::string err = fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel) +
                           fmt2(", min E %.3g -> %.3g", min3(min_before_), min3(min_after_));
         if (sun_) err += fmt2("; + sun vs whole: mean rel %.3g, max rel %.3g", sun_mean_, sun_max_);
@@ -165,21 +166,25 @@ private:
             src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ctx.ex);
         ibl::sh_coeffs<double, B> rad = raw;
         min_before_ = min_after_ = ibl::sh_min_irradiance(raw, 4096).value;
-        const dvec3 mean = ibl::sh_irradiance(raw)[0] * 0.282094791773878143; // E_00 Y_00: the mean of E over the sphere
         bool apply = window_ != "none" && window_ != "auto";
-        if (window_ == "auto")
-            for (int c = 0; c < 3; ++c) apply = apply || min_before_[c] < -window_threshold * mean[c];
+        if (window_ == "auto") apply = min3(min_before_) < 0.0;
         if (apply && window_ == "auto") {
             const ibl::sh_auto_window_result<double, B> win = ibl::sh_auto_window(raw);
             windowed_ = std::isfinite(win.width);
             width_ = win.width;
             rad = win.radiance;
+            if (!win.ok) // no window keeps E >= 0: clamp the channels that stay negative to E = 0
+                for (int c = 0; c < 3; ++c)
+                    if (!(win.min_after[c] >= 0.0)) {
+                        clamped_ = true;
+                        for (int k = 0; k < B * B; ++k) rad[k][c] = 0.0;
+                    }
         } else if (apply) {
             width_ = std::stod(window_);
             windowed_ = true;
             rad = ibl::sh_apply_window(raw, ibl::sh_window_kind::hanning, width_);
         }
-        if (windowed_) min_after_ = ibl::sh_min_irradiance(rad, 4096).value;
+        if (windowed_ || clamped_) min_after_ = ibl::sh_min_irradiance(rad, 4096).value;
         for (int k = 0; k < B * B; ++k) raw_[k] = raw[k], rad_[k] = rad[k];
     }
     void check(bake_context& ctx);
@@ -188,7 +193,7 @@ private:
     std::vector<std::pair<std::string, std::string>> conventions_;
     int bands_ = 3, texels_ = 0;
     std::string window_ = "auto";
-    bool windowed_ = false, sun_ = false, filament_ = false;
+    bool windowed_ = false, clamped_ = false, sun_ = false, filament_ = false;
     double width_ = 0.0, ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     dvec3 min_before_{0.0}, min_after_{0.0};
     sh5 raw_{}, rad_{}, irr_{}, shader_{};
@@ -234,8 +239,10 @@ std::string sh_stage::sh_json() const {
     else j.key("width").null();
     j.key("choice").value(window_);
     j.key("rule").value("'radiance' is the raw projection. --sh-window auto: the weakest Hanning window keeping E >= 0 "
-                        "(ibl::sh_auto_window) when the raw irradiance's minimum is below -5% of its mean in a channel; none; "
-                        "or a width W. A window scales band l of the irradiance and shader coefficients (then named *_windowed)");
+                        "(ibl::sh_auto_window) whenever the raw irradiance's minimum is negative in a channel (a channel no window "
+                        "can make non-negative is clamped to 0); none; or a width W. A window scales band l of the irradiance and "
+                        "shader coefficients (then named *_windowed)");
+    j.key("clamp_applied").value(clamped_);
     j.key("min_irradiance_before").begin_array().value(min_before_.x).value(min_before_.y).value(min_before_.z).end_array();
     j.key("min_irradiance_after").begin_array().value(min_after_.x).value(min_after_.y).value(min_after_.z).end_array();
     j.end_object();
@@ -253,6 +260,7 @@ void sh_stage::report(json_writer& j) const {
     j.key("window_applied").value(windowed_);
     if (windowed_) j.key("window_width").value(width_);
     else j.key("window_width").null();
+    j.key("clamp_applied").value(clamped_);
     j.key("min_irradiance_before").value(min3(min_before_));
     j.key("min_irradiance_after").value(min3(min_after_));
     j.key("check").begin_object();

@@ -174,7 +174,7 @@ std::vector<table_row> specular_stage::rows() const {
     int worst_l = 0;
     for (const auto& c : checks_)
         if (c.virtual_level > 0) {
-            if (c.m.rel_rmse > worst_rel) worst_rel = c.m.rel_rmse, worst_l = c.level;
+            if (c.m.rel_rmse > worst_rel) worst_rel = c.m.rel_rmse, worst_l = c.virtual_level;
             worst_over = std::max(worst_over, c.m.max_ratio);
         }
     const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
@@ -196,7 +196,7 @@ std::vector<table_row> specular_stage::rows() const {
                     fmt2("max rel %.3g, worst level rms rel %.3g", qmax, qrms) + ", " + std::to_string(clamped) + " values clamped"});
     for (const auto& c : checks_) {
         char name[64];
-        std::snprintf(name, sizeof name, "  l%d %dx%d r=%.2f", c.level, c.size, c.size, c.roughness);
+        std::snprintf(name, sizeof name, "  l%d %dx%d r=%.2f", c.virtual_level, c.size, c.size, c.roughness); // level 0 = mirror
         const std::string ref = c.virtual_level == 0 ? "texel mean " + std::to_string(level0_ref_k) + "^2"
                                 : analytic_      ? "ref: sky IS + sun cap quadrature"
                                                  : "ref: GGX IS " + std::to_string(qs_.ld_ref_samples) + " spp";

@@ -17,6 +17,7 @@
 //   split_sum     check: the baked products through the runtime model (and the plain split
 //                 sum) against the full integral
 //   preview       check: a sphere grid rendered from the baked products
+//   target_check  check (--scene): the scene's error targets measured on the products, met or missed
 //   compare_full  check (--scene --compare-full): full and converged bakes, the plan's error
 
 #include <array>
@@ -50,6 +51,7 @@ std::unique_ptr<stage> make_sheen_stage();
 std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
 std::unique_ptr<stage> make_preview_stage();
+std::unique_ptr<stage> make_target_check_stage();
 std::unique_ptr<stage> make_compare_full_stage();
 
 /// The BRDF model of every product and check.
@@ -131,6 +133,20 @@ int lobe_lut_size_for(int dfg_size);
 /// Their description in report.json.
 void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s, const ibl::dfg_lut_layout& d,
                              const runtime_model& rm);
+
+/// The shading points of the scene checks (target_check, compare_full): each material class at
+/// the ends and the middle of each roughness range, at 54 normals (3 x 3 texel centres per cube
+/// face) each seen at 45 degrees.
+struct scene_shading_material {
+    std::string name;
+    ibl::pbr_material<double> m;
+};
+struct scene_shading_point {
+    dvec3 n, v;
+};
+ibl::pbr_material<double> scene_material(double metallic, double roughness);
+std::vector<scene_shading_material> scene_shading_materials(const ibl::scene_description& scene);
+std::vector<scene_shading_point> scene_shading_points();
 
 /// The products of ctx as a renderer samples them.
 product_view baked_view(const bake_context& ctx);

@@ -135,3 +135,66 @@ TEST_CASE("scene: bad scene files") {
         CHECK_FALSE(fs::exists(s / "out"));
     }
 }
+
+TEST_CASE("scene: the targets are checked by default and reported") {
+    scratch s("targets");
+    const result r = run(s, "--scene " + scenes + "/mobile.json --out " + (s / "out") + tiny);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.out.find("scene targets") != std::string::npos);
+    CHECK(r.out.find("specular  target 0.2") != std::string::npos);
+    CHECK(r.out.find("diffuse   target 0.5") != std::string::npos);
+    const std::string report = slurp(s / "out/report.json");
+    CHECK(report.find("\"target_check\"") != std::string::npos);
+    CHECK(report.find("\"product\": \"specular\"") != std::string::npos);
+    CHECK(report.find("\"product\": \"diffuse\"") != std::string::npos);
+    CHECK(report.find("\"measured\"") != std::string::npos);
+    CHECK(report.find("\"met\"") != std::string::npos);
+    CHECK(report.find("\"uncertainty\"") != std::string::npos);
+}
+
+TEST_CASE("scene: a missed target warns; --strict makes it an error and writes nothing") {
+    scratch s("strict");
+    // a target far below what 2-band SH and the sample table reach: missed on any environment
+    const std::string scene = write(s, "tight.json", R"({"name": "tight", "error_target": 0.001,
+        "limits": {"max_sh_bands": 2, "max_samples": 64},
+        "materials": [{"name": "m", "metallic": 0.0, "roughness_range": [0.3, 0.9]}]})");
+    result r = run(s, "--scene " + scene + " --out " + (s / "out") + tiny);
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    CHECK(r.err.find("warning: scene target missed: specular") != std::string::npos);
+    CHECK(r.out.find("MISSED") != std::string::npos);
+    const std::string report = slurp(s / "out/report.json");
+    CHECK(report.find("\"all_met\": false") != std::string::npos);
+    CHECK(report.find("\"met\": false") != std::string::npos);
+
+    r = run(s, "--scene " + scene + " --strict --out " + (s / "strict") + tiny);
+    CHECK(r.status == 1);
+    CHECK(r.err.find("--strict: scene target missed") != std::string::npos);
+    CHECK_FALSE(fs::exists(s / "strict")); // all or nothing: the products are not kept
+
+    // an existing DIR is left as it was
+    fs::create_directories(s / "kept");
+    write(s, "kept/marker.txt", "x");
+    r = run(s, "--scene " + scene + " --strict --out " + (s / "kept") + tiny);
+    CHECK(r.status == 1);
+    CHECK(fs::exists(s / "kept/marker.txt"));
+    CHECK_FALSE(fs::exists(s / "kept/report.json"));
+
+    CHECK(run(s, "--strict --out " + (s / "nos") + tiny).status == 2); // --strict needs --scene
+}
+
+TEST_CASE("scene: the header and report.json give the sizes the plan bakes") {
+    scratch s("sizes");
+    const result r = run(s, "--scene " + scenes + "/mobile.json --size 256 --quality low --threads 2 --quiet --out " + (s / "out"));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    // mobile at --size 256: virtual base 128 (screen cap 64 at level 1), stored levels 1..5, DFG 32^2
+    CHECK(r.out.find("size 64, 5 levels (1..5 of 0..5), LUT 32") != std::string::npos);
+    CHECK(r.out.find("  level 1    64x64") != std::string::npos); // level 0 = the mirror level, everywhere
+    CHECK(r.out.find("  l1 64x64 r=0.20") != std::string::npos);
+    const std::string report = slurp(s / "out/report.json");
+    CHECK(report.find("\"face_size\": 64") != std::string::npos);
+    CHECK(report.find("\"stored_levels\": 5") != std::string::npos);
+    CHECK(report.find("\"lut_size\": 32") != std::string::npos);
+}

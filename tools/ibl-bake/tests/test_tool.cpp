@@ -472,3 +472,36 @@ TEST_CASE("existing DIR: files replaced, other files kept, stale levels removed"
     CHECK(read_image(out + "/dfg.exr").width == 16);
     for (const auto& e : entries(s.path)) CHECK(e.find(".ibl-bake-") == std::string::npos);
 }
+
+TEST_CASE("sh window auto: a slightly negative 3-band irradiance is windowed to min E >= 0") {
+    // A uniform sky of radiance 1 with a small bright spot of power ~95 (units of radiance x sr):
+    // the 3-band irradiance of a point source I has the minimum -0.0396 I, here ~2% of the mean
+    // irradiance below zero, less than the 5% the automatic window used to wait for.
+    scratch_dir s("shwin");
+    image_rgb32f img(64, 32);
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 64; ++x)
+            for (int c = 0; c < 3; ++c) img.texel(x, y)[c] = (y == 15 || y == 16) && (x == 10 || x == 11) ? 2460.0f : 1.0f;
+    write_hdr(s / "spot.hdr", img);
+    const std::string out = s / "bake";
+    const run_result r = run(s, with(tiny, {"--input", s / "spot.hdr", "--extract-sun", "off", "--sh-bands", "3", "--sh-window", "auto",
+                                            "--threads", "2", "--out", out}));
+    INFO(r.err);
+    REQUIRE(r.status == 0);
+    const json sh = parse_json(slurp(out + "/sh.json"));
+    const json& w = sh["window"];
+    REQUIRE(w["min_irradiance_before"].items.size() == 3);
+    const double mean_e = sh["radiance"].items[0].items[0].number * 3.14159265358979 * 0.282094791773878; // E_00 Y_00, red
+    const double before = w["min_irradiance_before"].items[0].number;
+    INFO("min E before " << before << ", mean E " << mean_e);
+    CHECK(before < 0.0);
+    CHECK(before > -0.05 * mean_e); // the old trigger (below -5% of the mean) would have left it
+    CHECK(w["applied"].boolean);
+    CHECK(sh.has("irradiance_windowed"));
+    for (const auto& c : w["min_irradiance_after"].items) CHECK(c.number >= 0.0);
+    const json rep = parse_json(slurp(out + "/report.json"));
+    CHECK(rep["sh"]["window_applied"].boolean);
+    CHECK_FALSE(rep["sh"]["clamp_applied"].boolean);
+    CHECK(rep["sh"]["min_irradiance_after"].number >= 0.0);
+    CHECK(rep["sh"]["min_irradiance_before"].number < 0.0);
+}
