@@ -38,7 +38,7 @@ TEST_CASE("plan: rough-only scene has no sharp levels and a smaller base") {
     CHECK(p.specular.virtual_base_size < full.specular.virtual_base_size);
     CHECK(p.source_size == p.specular.virtual_base_size);
     for (const auto& l : p.specular.levels) CHECK(l.needed);
-    CHECK(p.diffuse.kind == ibl::diffuse_product::sh); // dielectrics: diffuse lit by IBL
+    CHECK(p.diffuse.kind != ibl::diffuse_product::none); // dielectrics: diffuse lit by IBL (0.1: an irradiance map)
     CHECK(p.dfg.channels == 2);
     // stored lod = policy lod minus the first level
     CHECK(p.specular.stored_lod(0.5) == doctest::Approx(0.5));
@@ -66,7 +66,7 @@ TEST_CASE("plan: glossy metals need no irradiance and no rough levels") {
 
 TEST_CASE("plan: mobile gets a 32^2 DFG table and 2-band SH") {
     ibl::scene_description s = one_class("mixed", 0.5, 0.3, 0.9, 0.2, 128);
-    s.diffuse_error_target = 0.35;
+    s.diffuse_error_target = 0.5; // examples/scenes/mobile.json (2 bands, windowed: 0.451 at worst)
     const ibl::bake_plan p = ibl::make_bake_plan(s);
     CHECK(p.dfg.size == 32);
     CHECK(p.diffuse.kind == ibl::diffuse_product::sh);

@@ -88,11 +88,15 @@
 
 // ---- Diffuse -------------------------------------------------------------------------------------
 //   None when diffuse is not lit by IBL or every material is a bare metal (metallic = 1). Else SH:
-//   measured RMS(E_SH - E)/RMS(E) of 2 and 3 bands against a brute-force cosine integral of the
-//   same 64^2 cube (plan_measure.cpp; worst of default sky + sun, courtyard.exr, studio.exr):
-//       2 bands  0.344 (sky 0.344, courtyard 0.225, studio 0.320)
-//       3 bands  0.085 (sky 0.085, courtyard 0.036, studio 0.075)
-//   bands = 2 if the diffuse target >= 0.344, 3 if >= 0.085, otherwise an irradiance cubemap
+//   RMS(E_SH - E)/RMS(E) of 2 and 3 bands against a brute-force cosine integral of the same 64^2
+//   cube, for the SH irradiance as shipped (with the automatic window that keeps E >= 0; a sun
+//   left in the environment makes the raw projection ring negative, and the window costs
+//   accuracy): the worst over a sky with a sun and two real HDRIs, measured by
+//   `ibl_plan_measure sh` (figures in docs/scene-format.md):
+//       2 bands  0.451
+//       3 bands  0.120
+//   bands = 2 if the diffuse target >= sh2_irradiance_error, 3 if >= sh3_irradiance_error,
+//   otherwise an irradiance cubemap
 //   (integrate/irradiance.hpp, 32^2, 1024 filtered cosine samples) whose band limit is not 3.
 //   plan_limits::max_sh_bands caps the bands (a warning says when the target is then missed).
 //
@@ -321,8 +325,8 @@ inline constexpr int dfg_sizes[5] = {16, 32, 64, 128, 256};
 inline constexpr double dfg_interp_error[5] = {3.84e-2, 1.89e-2, 9.39e-3, 4.68e-3, 2.33e-3};
 
 /// Worst measured RMS(E_SH - E) / RMS(E) of 2 and 3 SH bands.
-inline constexpr double sh2_irradiance_error = 0.344;
-inline constexpr double sh3_irradiance_error = 0.085;
+inline constexpr double sh2_irradiance_error = 0.451;
+inline constexpr double sh3_irradiance_error = 0.120;
 
 // ---- the rules -------------------------------------------------------------------------------------
 
