@@ -26,6 +26,15 @@ quality_settings settings_for(quality q) {
     }
 }
 
+quality_settings check_settings_for(quality_settings q, const std::string& checks) {
+    if (checks != "fast") return q;
+    q.ref_grid = std::max(3, q.ref_grid - 3);
+    q.ld_ref_samples = std::max(256u, q.ld_ref_samples / 4);
+    q.sky_ref_samples = std::max(256u, q.sky_ref_samples / 4);
+    q.split_sum_samples = std::max(1u << 10, q.split_sum_samples / 8);
+    return q;
+}
+
 int auto_levels(int size) { return ibl::prefilter_auto_levels(size); }
 
 namespace {
@@ -114,6 +123,8 @@ const std::map<std::string, option_spec>& option_table() {
         {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
         {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
         {"--strict", {false, [](bake_options& o, const std::string&) { o.strict = true; }}},
+        {"--checks", {true, [](bake_options& o, const std::string& v) { o.checks = choice("--checks", v, {"fast", "full", "none"}); }}},
+        {"--verbose", {false, [](bake_options& o, const std::string&) { o.verbose = true; }}},
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
@@ -241,6 +252,9 @@ std::string usage_text() {
            "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
            "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
            "  --quiet            no progress on stderr\n"
+           "  --checks C         fast (default: cheaper references, checks <= 1/4 of the run) | full | none\n"
+           "                     (none: no reference checks; the products are written unchecked)\n"
+           "  --verbose          the wide report table (every column, every level and model)\n"
            "  --sh-bands B       SH bands 2..5 (default 3)\n"
            "  --sh-window W      auto (default) | none | Hanning width W: applied to irradiance and shader SH\n"
            "  --irradiance-size N  irradiance map face (default 32), 0 = none\n"
@@ -255,7 +269,8 @@ std::string usage_text() {
            "  --ld-weight W      nl (default: Karis D n.l) | g1 (D G1, the true lobe at n.v = 1)\n"
            "  --runtime M        split-sum (default: LD(R, r) DFG) | lobe (lobe LUT) | taps2 (two fitted taps)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
-           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, lobe NV R, taps NV R\n"
+           "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, sheen X Y Z R,\n"
+           "                     dfg_sheen NV R (--sheen bakes), lobe NV R, taps NV R\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --strict           with --scene: a missed error target is an error (exit 1, DIR untouched)\n"

@@ -41,6 +41,8 @@
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
 //   --strict            with --scene: a missed error target is an error (exit 1, DIR untouched)
+//   --checks C          fast (default: cheaper references, checks <= 1/4 of the run) | full | none
+//   --verbose           the wide report table (every column and sub-row) instead of the compact one
 //   --help, --version
 // Values may be given as "--size 32" or "--size=32". Numbers must be plain decimal integers.
 
@@ -94,6 +96,8 @@ struct bake_options {
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)
     bool strict = false;       ///< --strict (with --scene): a missed error target fails the bake
+    std::string checks = "fast"; ///< the reference checks: fast | full | none (check_settings_for)
+    bool verbose = false;      ///< --verbose: the wide report table
 };
 
 /// Cost knobs of one quality preset (docs/ibl-bake.md has the table).
@@ -112,6 +116,11 @@ struct quality_settings {
 };
 
 quality_settings settings_for(quality q);
+
+/// The quality's settings with the check knobs of a --checks mode: full keeps them; fast takes a
+/// coarser texel grid (ref_grid - 3, at least 3), a quarter of the reference samples and an
+/// eighth of the split-sum reference's (docs/ibl-bake.md "Checks"); none keeps them (no check runs).
+quality_settings check_settings_for(quality_settings q, const std::string& checks);
 
 /// Parses argv[1..argc). Throws usage_error.
 bake_options parse_options(const std::vector<std::string>& args);

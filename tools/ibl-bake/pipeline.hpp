@@ -166,6 +166,8 @@ public:
     virtual void report(json_writer& j) const = 0;
     /// Time of the product itself (checks excluded); product stages only.
     virtual double product_ms() const { return 0.0; }
+    /// Time of its reference checks (0 when none ran: --checks none).
+    virtual double check_ms() const { return 0.0; }
     /// The product category of measured_ms: "source", "specular", "diffuse", "dfg" or "lobe_lut".
     virtual const char* category() const { return ""; }
 };

@@ -29,6 +29,7 @@ public:
     const char* category() const override { return "dfg"; }
     bool enabled(const bake_context& ctx) const override { return ctx.plan.dfg.enabled && ctx.plan.dfg.size > 0; }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
         nodes_ = ctx.qs.dfg_nodes;
@@ -47,6 +48,8 @@ public:
         for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
         attrs_.push_back({"ibl.model", lut_->model});
         attrs_.push_back({"ibl.dfg_channels", filament_channels_ ? "B, A + B, k" : "A, B, k"});
+        checked_ = ctx.opt.checks != "none";
+        if (!checked_) return;
         ctx.prog.begin("check dfg");
         check(ctx.ex);
         const ibl::dfg_error_grid grid = ibl::dfg_error_grid::dense(33, 24, 0.05);
@@ -57,13 +60,20 @@ public:
     }
 
     std::vector<table_row> rows() const override {
-        return {{"dfg lut", std::string("quadrature, ") + bake_model::name,
-                 std::to_string(lut_->size) + "^2, " + std::to_string(nodes_.evaluations()) + " evals/texel", ms_,
-                 fmt("max abs %.3g vs dfg_exact", max_abs_)},
-                {"  dfg lookup", std::string("bilinear, ") + (layout_.edge_aligned ? "remapped layout" : "uniform layout"),
-                 std::to_string(lookup_.count) + " points, r >= 0.05", -1.0,
-                 fmt2("max abs %.3g (half %.3g)", lookup_.max_abs, lookup_half_.max_abs) +
-                     fmt2(" at n.v %.3g r %.3g", lookup_.worst_n_dot_v, lookup_.worst_roughness)}};
+        const std::string cost = std::to_string(lut_->size) + "^2, " + std::to_string(nodes_.evaluations()) + " evals/texel";
+        const std::string method = std::string("quadrature, ") + bake_model::name;
+        if (!checked_) return {table_row{"dfg lut", method, cost, ms_, "not checked"}.compact("quadrature", "not checked")};
+        const std::string layout = layout_.edge_aligned ? "remapped" : "uniform";
+        return {table_row{"dfg lut", method, cost, ms_, fmt("max abs %.3g vs dfg_exact", max_abs_)}
+                    .compact("quadrature", fmt("max abs %.3g at the texels", max_abs_))
+                    .alarm(max_abs_, alarm_absolute, "the table's quadrature is off by > 0.01: --quality high takes more nodes"),
+                table_row{"  dfg lookup", "bilinear, " + layout + " layout", std::to_string(lookup_.count) + " points, r >= 0.05", -1.0,
+                          fmt2("max abs %.3g (half %.3g)", lookup_.max_abs, lookup_half_.max_abs) +
+                              fmt2(" at n.v %.3g r %.3g", lookup_.worst_n_dot_v, lookup_.worst_roughness)}
+                    .compact("bilinear, " + layout, fmt2("max abs %.3g at n.v %.3g", lookup_.max_abs, lookup_.worst_n_dot_v))
+                    .alarm(lookup_.max_abs, alarm_absolute,
+                           layout_.edge_aligned ? "bilinear reads between texels are off by > 0.01: raise --lut-size"
+                                                : "texel centres miss n.v -> 0 (textbook table): --dfg-layout remapped fixes it")};
     }
     std::vector<file_out> files() const override;
     void report(json_writer& j) const override;
@@ -83,7 +93,7 @@ private:
             }
         });
         max_abs_ = *std::max_element(err.begin(), err.end());
-        checked_ = err.size();
+        texels_checked_ = err.size();
     }
 
     const ibl::dfg_lut* lut_ = nullptr;
@@ -104,7 +114,8 @@ private:
     ibl::dfg_quadrature_nodes nodes_{};
     std::string quality_;
     double ms_ = 0.0, check_ms_ = 0.0, max_abs_ = 0.0;
-    std::size_t checked_ = 0;
+    std::size_t texels_checked_ = 0;
+    bool checked_ = true;
 };
 
 std::vector<file_out> dfg_stage::files() const {
@@ -149,9 +160,15 @@ void dfg_stage::report(json_writer& j) const {
                                 "(top) = roughness 0, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)"
                               : "x = n.v = (i + 0.5)/N, y = roughness = (j + 0.5)/N (texel centres); EXR row 0 (top) = "
                                 "roughness 0.5/N, roughness increases downwards; R = A, G = B, B = k (0 for a 2-channel table)");
+    if (!checked_) { // --checks none
+        j.key("check").begin_object().key("ran").value(false).end_object();
+        j.end_object();
+        return;
+    }
     j.key("check").begin_object();
+    j.key("ran").value(checked_);
     j.key("reference").value("ibl::dfg_exact (default nodes, converged to 1e-6)");
-    j.key("texels").value(checked_);
+    j.key("texels").value(texels_checked_);
     j.key("max_abs").value(max_abs_);
     j.key("time_ms").value(check_ms_);
     j.end_object();

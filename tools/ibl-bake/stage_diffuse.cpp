@@ -40,6 +40,9 @@ constexpr int brute_max_face = 128; ///< brute-force irradiance over a source le
 
 double min3(const dvec3& v) { return std::min({v.x, v.y, v.z}); }
 
+/// The brute-force level's largest face: --checks fast sums over a level of face <= 64.
+int brute_face(const bake_context& ctx) { return ctx.opt.checks == "fast" ? 64 : brute_max_face; }
+
 std::vector<dvec3> check_normals() {
     std::vector<dvec3> normals;
     for (int f = 0; f < 6; ++f)
@@ -91,7 +94,7 @@ void check_with_sun(const bake_context& ctx, const std::vector<dvec3>& normals, 
     mean = max = 0.0;
     if (!ctx.sun) return;
     const ibl::cubemap<float>& whole = ctx.whole_source();
-    const std::vector<dvec3> ref = texel_sum_irradiance(whole, level_at_most(whole, brute_max_face), normals, ctx.ex);
+    const std::vector<dvec3> ref = texel_sum_irradiance(whole, level_at_most(whole, brute_face(ctx)), normals, ctx.ex);
     accumulate(c, normals, ref, [&](const dvec3& n) { return e_product(n) + ibl::disk_light_irradiance(n, *ctx.sun); }, mean, max);
 }
 
@@ -102,6 +105,7 @@ public:
     const char* category() const override { return "diffuse"; }
     bool enabled(const bake_context& ctx) const override { return ctx.plan.diffuse.kind == ibl::diffuse_product::sh || !ctx.scene_mode; }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return checked_ ? c_.ms : 0.0; }
 
     void run(bake_context& ctx) override {
         bands_ = ctx.opt.sh_bands > 0 ? ctx.opt.sh_bands : ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
@@ -126,7 +130,8 @@ public:
         }
         conventions_ = product_conventions(ctx, "sh", "real SH radiance coefficients; E(n) and E(n)/pi reconstructed as "
                                                       "'convention' says");
-        check(ctx);
+        checked_ = ctx.opt.checks != "none";
+        if (checked_) check(ctx);
     }
 
     std::vector<table_row> rows() const override {
@@ -136,7 +141,12 @@ public:
         std::string err = fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel) +
                           fmt2(", min E %.3g -> %.3g", min3(min_before_), min3(min_after_));
         if (sun_) err += fmt2("; + sun vs whole: mean rel %.3g, max rel %.3g", sun_mean_, sun_max_);
-        return {{"sh irradiance", method, std::to_string(texels_) + " texels", ms_, err}};
+        const std::string brief = std::to_string(bands_) + "-band SH" + (windowed_ ? fmt(", window %.3g", width_) : std::string());
+        if (!checked_) return {table_row{"sh irradiance", method, std::to_string(texels_) + " texels", ms_, "not checked"}.compact(brief, "not checked")};
+        return {table_row{"sh irradiance", method, std::to_string(texels_) + " texels", ms_, err}
+                    .compact(brief, fmt2("max rel %.3g (mean %.3g)", c_.max_rel, c_.mean_rel))
+                    .alarm(c_.max_rel, alarm_relative,
+                           "few SH bands cannot hold sharp light (their limit, not a bake defect): use the irradiance map")};
     }
     std::vector<file_out> files() const override {
         std::vector<file_out> f{{"sh.json", [this](const std::string& p) { write_text(p, sh_json()); }}};
@@ -193,7 +203,7 @@ private:
     std::vector<std::pair<std::string, std::string>> conventions_;
     int bands_ = 3, texels_ = 0;
     std::string window_ = "auto";
-    bool windowed_ = false, clamped_ = false, sun_ = false, filament_ = false;
+    bool windowed_ = false, clamped_ = false, sun_ = false, filament_ = false, checked_ = true;
     double width_ = 0.0, ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     dvec3 min_before_{0.0}, min_after_{0.0};
     sh5 raw_{}, rad_{}, irr_{}, shader_{};
@@ -203,7 +213,7 @@ private:
 void sh_stage::check(bake_context& ctx) {
     const auto t0 = std::chrono::steady_clock::now();
     ctx.prog.begin("check sh");
-    c_.level = level_at_most(ctx.source, brute_max_face);
+    c_.level = level_at_most(ctx.source, brute_face(ctx));
     c_.face = ctx.source.size(c_.level);
     const std::vector<dvec3> normals = check_normals();
     const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
@@ -263,7 +273,13 @@ void sh_stage::report(json_writer& j) const {
     j.key("clamp_applied").value(clamped_);
     j.key("min_irradiance_before").value(min3(min_before_));
     j.key("min_irradiance_after").value(min3(min_after_));
+    if (!checked_) { // --checks none
+        j.key("check").begin_object().key("ran").value(false).end_object();
+        j.end_object();
+        return;
+    }
     j.key("check").begin_object();
+    j.key("ran").value(checked_);
     j.key("reference").value("brute-force cosine integration over every texel of source level " + std::to_string(c_.level) + " (" +
                              std::to_string(c_.face) + "^2 faces)");
     j.key("normals").value(c_.normals);
@@ -286,6 +302,7 @@ public:
         return ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map || (!ctx.scene_mode && ctx.opt.irradiance_size > 0);
     }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return checked_ ? c_.ms : 0.0; }
 
     void run(bake_context& ctx) override {
         size_ = ctx.plan.diffuse.kind == ibl::diffuse_product::irradiance_map ? ctx.plan.diffuse.map_size : ctx.opt.irradiance_size;
@@ -297,8 +314,10 @@ public:
         format_ = ctx.opt.ktx2_format;
         attrs_ = product_conventions(ctx, "irradiance", "texel holds the irradiance E(n) (not E/pi) for the normal n through "
                                                         "it; diffuse = albedo E(n) / pi");
+        checked_ = ctx.opt.checks != "none";
+        if (!checked_) return;
         const auto t0 = std::chrono::steady_clock::now();
-        c_.level = level_at_most(ctx.source, brute_max_face);
+        c_.level = level_at_most(ctx.source, brute_face(ctx));
         c_.face = ctx.source.size(c_.level);
         const std::vector<dvec3> normals = check_normals();
         const std::vector<dvec3> ref = texel_sum_irradiance(ctx.source, c_.level, normals, ctx.ex);
@@ -312,8 +331,11 @@ public:
     std::vector<table_row> rows() const override {
         std::string err = fmt2("mean rel %.3g, max rel %.3g", c_.mean_rel, c_.max_rel);
         if (sun_) err += fmt2("; + sun vs whole: mean rel %.3g, max rel %.3g", sun_mean_, sun_max_);
-        return {{"irradiance map", "texel moments over level 0", std::to_string(size_) + "^2, blocks <= " + std::to_string(max_face_) + "^2",
-                 ms_, err}};
+        const std::string cost = std::to_string(size_) + "^2, blocks <= " + std::to_string(max_face_) + "^2";
+        if (!checked_) return {table_row{"irradiance map", "texel moments over level 0", cost, ms_, "not checked"}.compact("texel moments", "not checked")};
+        return {table_row{"irradiance map", "texel moments over level 0", cost, ms_, err}
+                    .compact("texel moments", fmt2("max rel %.3g (mean %.3g)", c_.max_rel, c_.mean_rel))
+                    .alarm(c_.max_rel, alarm_relative, "the map is > 5% off the brute-force integral: raise --irradiance-size")};
     }
     std::vector<file_out> files() const override {
         std::vector<file_out> f;
@@ -332,7 +354,13 @@ public:
         j.key("method").value("irradiance cubemap by texel moments over source level 0 (ibl::irradiance_cubemap_texel_moments); texels hold E");
         j.key("cost").begin_object().key("size").value(size_).key("block_face").value(max_face_).end_object();
         j.key("time_ms").value(ms_);
+        if (!checked_) { // --checks none
+            j.key("check").begin_object().key("ran").value(false).end_object();
+            j.end_object();
+            return;
+        }
         j.key("check").begin_object();
+        j.key("ran").value(checked_);
         j.key("reference").value("brute-force cosine integration over every texel of source level " + std::to_string(c_.level));
         j.key("normals").value(c_.normals).key("mean_rel").value(c_.mean_rel).key("max_rel").value(c_.max_rel);
         if (sun_) j.key("with_sun_vs_whole_source").begin_object().key("mean_rel").value(sun_mean_).key("max_rel").value(sun_max_).end_object();
@@ -347,7 +375,7 @@ private:
     std::vector<std::pair<std::string, std::string>> attrs_;
     const ibl::cubemap<float>* map_ = nullptr;
     double ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
-    bool sun_ = false;
+    bool sun_ = false, checked_ = true;
     irradiance_check c_;
 };
 

@@ -62,6 +62,7 @@ public:
         return ctx.lut && ctx.chain && runtime_model_of(ctx.opt, ctx.plan).name == "taps2";
     }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
         layout_ = dfg_layout_named(ctx.opt.dfg_layout);
@@ -77,27 +78,36 @@ public:
                                                        "/ sum_k w_k (ibl_specular_lobe_taps2)");
         for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
         attrs_.push_back({"ibl.ld_weight", weight_name_});
+        checks_ = ctx.opt.checks;
+        if (checks_ == "none") return;
         ctx.prog.begin("check lobe taps");
         ab_max_abs_ = ab_vs_dfg(lut_->data, lut_->size, lut_->channels, layout_, *ctx.lut);
-        check_midpoints(ctx.ex);
+        check_midpoints(ctx.ex, checks_ == "full");
         check_ms_ = ctx.prog.end();
     }
 
     std::vector<table_row> rows() const override {
         const ibl::lobe_fit_options o = fit_options();
-        return {{"lobe taps", std::string("L1 fit of two kernels, ") + bake_model::name + ", chain weight " + weight_name_,
-                 std::to_string(lut_->size) + "^2, " + std::to_string(o.nodes) + "^2 points/texel", ms_,
-                 fmt2("fit L1 mean %.3g, max %.3g", lut_->mean_l1, lut_->max_l1) + fmt("; A,B vs dfg max abs %.3g", ab_max_abs_) +
-                     fmt2("; midpoint L1 table %.3g, direct fit %.3g", l1_.table_mean, l1_.fit_mean)}};
+        const std::string method = std::string("L1 fit of two kernels, ") + bake_model::name + ", chain weight " + weight_name_;
+        const std::string cost = std::to_string(lut_->size) + "^2, " + std::to_string(o.nodes) + "^2 points/texel";
+        const std::string fit = fmt2("fit L1 mean %.3g, max %.3g", lut_->mean_l1, lut_->max_l1);
+        if (checks_ == "none") return {table_row{"lobe taps", method, cost, ms_, fit}.compact("L1 fit, two kernels", fmt("fit L1 mean %.3g", lut_->mean_l1))};
+        const bool fits = checks_ == "full";
+        return {table_row{"lobe taps", method, cost, ms_,
+                          fit + fmt("; A,B vs dfg max abs %.3g", ab_max_abs_) + fmt("; midpoint L1 table %.3g", l1_.table_mean) +
+                              (fits ? fmt(", direct fit %.3g", l1_.fit_mean) : std::string())}
+                    .compact("L1 fit, two kernels", fmt("midpoint L1 %.3g", l1_.table_mean) +
+                                                        (fits ? fmt(" (direct fit %.3g)", l1_.fit_mean) : std::string()))};
     }
     std::vector<file_out> files() const override;
     void report(json_writer& j) const override;
 
 private:
-    void check_midpoints(pool_executor& ex);
+    void check_midpoints(pool_executor& ex, bool fits);
     void report_check(json_writer& j) const;
 
     const ibl::lobe_taps_lut* lut_ = nullptr;
+    std::string checks_ = "fast";
     ibl::dfg_lut_layout layout_{};
     std::vector<std::pair<std::string, std::string>> attrs_;
     ibl::ld_weight weight_ = ibl::ld_weight::g1;
@@ -119,7 +129,8 @@ std::array<ibl::lobe_tap, ibl::lobe_max_taps> taps_of(const std::array<float, ta
     return t;
 }
 
-void lobe_taps_stage::check_midpoints(pool_executor& ex) {
+/// fits: also a direct fit at each midpoint (--checks full; most of the check's time).
+void lobe_taps_stage::check_midpoints(pool_executor& ex, bool fits) {
     const std::uint32_t n = lut_->size;
     std::vector<std::array<double, 4>> pts; // n.v, r, L1 of the table's taps, of a direct fit
     for (const auto& m : fit_check_midpoints(n, layout_)) pts.push_back({m[0], m[1], 0.0, 0.0});
@@ -132,14 +143,21 @@ void lobe_taps_stage::check_midpoints(pool_executor& ex) {
             const double nv = pts[k][0], r = pts[k][1];
             const ibl::detail::lobe_points lp = ibl::detail::make_lobe_points<bake_model>(nv, r, check_nodes);
             pts[k][2] = ibl::detail::mixture_l1(lp, taps_of(pv.taps_params(nv, r), nv), 2, weight_, {});
-            const ibl::lobe_mixture f = ibl::fit_specular_lobe<bake_model>(nv, r, weight_, o);
-            pts[k][3] = ibl::detail::mixture_l1(lp, f.taps, 2, weight_, {});
         }
     });
+    if (fits)
+        ex(pts.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t k = b; k < e; ++k) {
+                const double nv = pts[k][0], r = pts[k][1];
+                const ibl::detail::lobe_points lp = ibl::detail::make_lobe_points<bake_model>(nv, r, check_nodes);
+                const ibl::lobe_mixture f = ibl::fit_specular_lobe<bake_model>(nv, r, weight_, o);
+                pts[k][3] = ibl::detail::mixture_l1(lp, f.taps, 2, weight_, {});
+            }
+        });
     for (const auto& p : pts) {
         l1_.table_mean += p[2] / double(pts.size());
         l1_.fit_mean += p[3] / double(pts.size());
-        if (p[2] - p[3] > l1_.excess_max) l1_.excess_max = p[2] - p[3], l1_.worst_n_dot_v = p[0], l1_.worst_roughness = p[1];
+        if (fits && p[2] - p[3] > l1_.excess_max) l1_.excess_max = p[2] - p[3], l1_.worst_n_dot_v = p[0], l1_.worst_roughness = p[1];
     }
     cells_ = pts.size();
 }
@@ -191,12 +209,22 @@ void lobe_taps_stage::report(json_writer& j) const {
 
 void lobe_taps_stage::report_check(json_writer& j) const {
     j.key("check").begin_object();
+    j.key("ran").value(checks_ != "none");
+    if (checks_ == "none") { // --checks none
+        j.end_object();
+        return;
+    }
+    j.key("direct_fits").value(checks_ == "full");
     j.key("ab_vs_dfg_max_abs").value(ab_max_abs_);
     j.key("midpoints").value(cells_);
     j.key("l1").begin_object();
-    j.key("table_mean").value(l1_.table_mean).key("direct_fit_mean").value(l1_.fit_mean);
-    j.key("excess_max").value(l1_.excess_max).key("worst_n_dot_v").value(l1_.worst_n_dot_v);
-    j.key("worst_roughness").value(l1_.worst_roughness).end_object();
+    j.key("table_mean").value(l1_.table_mean);
+    if (checks_ == "full") { // --checks fast leaves out the direct fits
+        j.key("direct_fit_mean").value(l1_.fit_mean);
+        j.key("excess_max").value(l1_.excess_max).key("worst_n_dot_v").value(l1_.worst_n_dot_v);
+        j.key("worst_roughness").value(l1_.worst_roughness);
+    }
+    j.end_object();
     j.key("method").value("A, B against ibl::dfg_lookup of the DFG table at the table's texels; at the midpoints of every "
                           "second cell per axis (r >= 0.05) the L1 distance to the lobe (" + std::to_string(check_nodes) +
                           "^2 points; 2 = disjoint) of the taps read bilinearly (as ibl::specular_lobe_taps reads them) "

@@ -110,8 +110,9 @@ public:
     }
 
     std::vector<table_row> rows() const override {
-        return {{"preview", "baked products, orthographic spheres",
-                 "640x256, " + std::to_string(ss_) + "x" + std::to_string(ss_) + " ss", ms_, fmt("exposure %.3g", png_.exposure)}};
+        return {table_row{"preview", "baked products, orthographic spheres",
+                          "640x256, " + std::to_string(ss_) + "x" + std::to_string(ss_) + " ss", ms_, fmt("exposure %.3g", png_.exposure)}
+                    .compact("spheres (preview.png)", fmt("exposure %.3g", png_.exposure))};
     }
     std::vector<file_out> files() const override {
         return {{"preview.png", [this](const std::string& p) { write_png(p, img_, png_); }}};

@@ -41,6 +41,7 @@ public:
     const char* category() const override { return "specular"; }
     bool enabled(const bake_context& ctx) const override { return ctx.opt.sheen && ctx.chain; }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
         ibl::prefilter_options po;
@@ -62,6 +63,8 @@ public:
                                                    "at R by textureLod(chain, R, lod(r))");
         lut_attrs_ = product_conventions(ctx, "sheen_lut", "R = sheen albedo E(n.v, r) (Charlie NDF, Neubelt visibility)");
         for (auto& kv : table_layout_keys(lut_.layout)) lut_attrs_.push_back(kv);
+        checked_ = ctx.opt.checks != "none";
+        if (!checked_) return;
         ctx.prog.begin("check sheen");
         const auto t0 = std::chrono::steady_clock::now();
         // Level 0 (r = 0: a ring of zero width at R's horizon) is below any texel sum's resolution:
@@ -78,9 +81,16 @@ public:
         double worst = 0.0;
         for (const auto& m : levels_)
             if (std::isfinite(m.rel_rmse)) worst = std::max(worst, m.rel_rmse);
-        return {{"sheen chain", std::string("Charlie filtered IS") + (sun_ ? " + sun term" : ""), std::to_string(chain_.levels()) + " levels", ms_,
-                 fmt("worst rel RMSE (levels >= 1) %.3g vs texel-sum Charlie LD", worst)},
-                {"sheen lut", "quadrature (Neubelt V)", std::to_string(lut_.size) + "^2", -1.0, fmt("max abs %.3g vs sheen_albedo", lut_max_abs_)}};
+        const std::string method = std::string("Charlie filtered IS") + (sun_ ? " + sun term" : "");
+        if (!checked_)
+            return {table_row{"sheen chain", method, std::to_string(chain_.levels()) + " levels", ms_, "not checked"}.compact("Charlie filtered IS", "not checked")};
+        return {table_row{"sheen chain", method, std::to_string(chain_.levels()) + " levels", ms_,
+                          fmt("worst rel RMSE (levels >= 1) %.3g vs texel-sum Charlie LD", worst)}
+                    .compact("Charlie filtered IS", fmt("worst rel RMSE %.3g (levels >= 1)", worst))
+                    .alarm(worst, alarm_relative, "sheen levels > 5% off the texel-sum Charlie LD: more samples (--quality high)"),
+                table_row{"sheen lut", "quadrature (Neubelt V)", std::to_string(lut_.size) + "^2", -1.0, fmt("max abs %.3g vs sheen_albedo", lut_max_abs_)}
+                    .compact("quadrature (Neubelt V)", fmt("max abs %.3g", lut_max_abs_))
+                    .alarm(lut_max_abs_, alarm_absolute, "the sheen table's quadrature is off by > 0.01: --quality high")};
     }
     std::vector<file_out> files() const override {
         std::vector<file_out> f;
@@ -140,6 +150,7 @@ private:
     std::vector<std::uint32_t> samples_;
     std::vector<ibl::error_metrics> levels_;
     double ms_ = 0.0, check_ms_ = 0.0, lut_max_abs_ = 0.0;
+    bool checked_ = true;
 };
 
 void sheen_stage::report(json_writer& j) const {
@@ -154,6 +165,7 @@ void sheen_stage::report(json_writer& j) const {
     j.end_array();
     j.key("time_ms").value(ms_);
     j.key("check").begin_object();
+    j.key("ran").value(checked_);
     j.key("levels").begin_array();
     for (std::size_t l = 0; l < levels_.size(); ++l)
         j.begin_object().key("level").value(int(l)).key("rel_rmse").value(levels_[l].rel_rmse).key("max_overshoot").value(levels_[l].max_ratio).end_object();

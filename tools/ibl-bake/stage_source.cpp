@@ -61,10 +61,13 @@ public:
     std::vector<table_row> rows() const override {
         std::vector<table_row> r;
         if (!src_->analytic)
-            r.push_back({"input", src_->rr.format + " " + src_->layout + " " + std::to_string(src_->width) + "x" + std::to_string(src_->height),
-                         std::to_string(src_->rr.negative_values) + " negative values clamped", read_ms_, "-"});
-        r.push_back({"source cube", "supersampled bake + box mips",
-                     std::to_string(size_) + "^2, " + std::to_string(k_) + "x" + std::to_string(k_) + " sub-samples", cube_ms_, "-"});
+            r.push_back(table_row{"input", src_->rr.format + " " + src_->layout + " " + std::to_string(src_->width) + "x" + std::to_string(src_->height),
+                                  std::to_string(src_->rr.negative_values) + " negative values clamped", read_ms_, "-"}
+                            .compact(src_->rr.format + " " + src_->layout, std::to_string(src_->width) + "x" + std::to_string(src_->height) + ", " +
+                                                                               std::to_string(src_->rr.negative_values) + " negatives clamped"));
+        r.push_back(table_row{"source cube", "supersampled bake + box mips",
+                              std::to_string(size_) + "^2, " + std::to_string(k_) + "x" + std::to_string(k_) + " sub-samples", cube_ms_, "-"}
+                        .compact("supersampled bake", std::to_string(size_) + "^2, " + std::to_string(k_) + "x" + std::to_string(k_) + " sub-samples"));
         return r;
     }
 

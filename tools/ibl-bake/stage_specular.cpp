@@ -75,6 +75,7 @@ public:
     const char* category() const override { return "specular"; }
     bool enabled(const bake_context& ctx) const override { return ctx.plan.specular.enabled && !ctx.plan.specular.levels.empty(); }
     double product_ms() const override { return ms_; }
+    double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
         ctx.prog.begin("prefilter");
@@ -88,9 +89,11 @@ public:
         format_ = ctx.opt.ktx2_format;
         metadata_ = chain_metadata(ctx);
         layouts_ = ctx.opt.layouts;
-        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_named(format_));
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
+        checked_ = ctx.opt.checks != "none";
+        if (!checked_) return;
         ctx.prog.begin("check specular");
+        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_named(format_));
         for (int k = 0; k < chain_->levels(); ++k) {
             ctx.prog.label("level " + std::to_string(k) + "/" + std::to_string(chain_->levels() - 1));
             checks_.push_back(check_level(ctx, k));
@@ -123,6 +126,7 @@ private:
     quality_settings qs_{};
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
+    bool checked_ = true;
     std::vector<level_check> checks_;
 };
 
@@ -170,6 +174,12 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
 }
 
 std::vector<table_row> specular_stage::rows() const {
+    const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
+                                ? std::to_string(qs_.prefilter_samples) + "*2^(l-1) spp"
+                                : "planned spp";
+    const std::string method = std::string("GGX filtered IS") + (sp_.trilinear ? " (trilinear)" : "");
+    const std::string cost = spp + ", " + std::to_string(sp_.levels.size()) + " levels";
+    if (!checked_) return {table_row{"specular chain", method, cost, ms_, "not checked (--checks none)"}.compact("GGX filtered IS", "not checked")};
     double worst_rel = 0.0, worst_over = 0.0;
     int worst_l = 0;
     for (const auto& c : checks_)
@@ -177,31 +187,36 @@ std::vector<table_row> specular_stage::rows() const {
             if (c.m.rel_rmse > worst_rel) worst_rel = c.m.rel_rmse, worst_l = c.virtual_level;
             worst_over = std::max(worst_over, c.m.max_ratio);
         }
-    const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
-                                ? std::to_string(qs_.prefilter_samples) + "*2^(l-1) spp"
-                                : "planned spp";
+    const bool any = worst_rel > 0.0 || checks_.size() > 1;
     std::vector<table_row> rows;
-    rows.push_back({"specular chain", std::string("GGX filtered IS") + (sp_.trilinear ? " (trilinear)" : ""),
-                    spp + ", " + std::to_string(checks_.size()) + " levels", ms_,
-                    worst_rel > 0.0 || checks_.size() > 1
-                        ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) + fmt(", max overshoot %.3g", worst_over)
-                        : "-"});
+    rows.push_back(table_row{"specular chain", method, cost, ms_,
+                             any ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) + fmt(", max overshoot %.3g", worst_over) : "-"}
+                       .compact("GGX filtered IS", any ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) : "-")
+                       .alarm(worst_rel, alarm_relative,
+                              "levels > 5% off the exact LD: more samples (--quality high), or --extract-sun on for a sun"));
     double qmax = 0.0, qrms = 0.0;
     std::size_t clamped = 0;
     for (const auto& q : quant_) {
         qmax = std::max(qmax, q.max_rel_error), qrms = std::max(qrms, q.rms_rel_error);
         clamped += q.above_range + q.negative_clamped + q.nan;
     }
-    rows.push_back({"  specular.ktx2", format_ + " storage vs float", std::to_string(quant_.size()) + " levels", -1.0,
-                    fmt2("max rel %.3g, worst level rms rel %.3g", qmax, qrms) + ", " + std::to_string(clamped) + " values clamped"});
+    table_row q{"  specular.ktx2", format_ + " storage vs float", std::to_string(quant_.size()) + " levels", -1.0,
+                fmt2("max rel %.3g, worst level rms rel %.3g", qmax, qrms) + ", " + std::to_string(clamped) + " values clamped"};
+    q.compact(format_ + " storage", fmt("max rel %.3g, ", qmax) + std::to_string(clamped) + " clamped");
+    if (clamped > 0)
+        q.meaning = "values beyond the format's range were clamped: --ktx2-format rgba32f stores them (or scale the input)";
+    else
+        q.alarm(qmax, alarm_quantisation, "the format's rounding, not the bake: --ktx2-format rgba16f or rgba32f keep more bits");
+    rows.push_back(q);
     for (const auto& c : checks_) {
         char name[64];
         std::snprintf(name, sizeof name, "  l%d %dx%d r=%.2f", c.virtual_level, c.size, c.size, c.roughness); // level 0 = mirror
         const std::string ref = c.virtual_level == 0 ? "texel mean " + std::to_string(level0_ref_k) + "^2"
                                 : analytic_      ? "ref: sky IS + sun cap quadrature"
                                                  : "ref: GGX IS " + std::to_string(qs_.ld_ref_samples) + " spp";
-        rows.push_back({name, ref, std::to_string(c.texels) + " texels", c.ref_ms,
-                        fmt2("rel RMSE %.3g, overshoot %.3g", c.m.rel_rmse, c.m.max_ratio)});
+        table_row r{name, ref, std::to_string(c.texels) + " texels", c.ref_ms, fmt2("rel RMSE %.3g, overshoot %.3g", c.m.rel_rmse, c.m.max_ratio)};
+        r.detail = true;
+        rows.push_back(r);
     }
     return rows;
 }
@@ -239,7 +254,8 @@ void specular_stage::report(json_writer& j) const {
     for (const auto& l : layouts_) j.value(l);
     j.end_array();
     j.key("ktx2_quantisation");
-    json_quantisation(j, quant_, format_);
+    if (checked_) json_quantisation(j, quant_, format_);
+    else j.null();
     j.key("method").value(std::string("GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
@@ -260,6 +276,7 @@ void specular_stage::report(json_writer& j) const {
                              ", with the chain's LD weight");
     j.key("texels").value("per level: a grid per face plus the 3x3 block around the brightest direction");
     j.key("relative_error_floor").value(floor_);
+    j.key("ran").value(checked_);
     j.key("time_ms").value(check_ms_);
     j.end_object();
     report_levels(j);
@@ -268,20 +285,27 @@ void specular_stage::report(json_writer& j) const {
 
 void specular_stage::report_levels(json_writer& j) const {
     j.key("levels").begin_array();
-    for (const auto& c : checks_) {
+    for (std::size_t k = 0; k < sp_.levels.size(); ++k) {
+        const ibl::specular_level_plan& lp = sp_.levels[k];
+        const level_check* c = k < checks_.size() ? &checks_[k] : nullptr;
         j.begin_object();
-        j.key("level").value(c.level);
-        j.key("virtual_level").value(c.virtual_level);
-        j.key("size").value(c.size);
-        j.key("roughness").value(c.roughness);
-        j.key("samples").value(c.samples);
-        j.key("trilinear").value(c.trilinear);
-        j.key("texels_compared").value(c.texels);
-        j.key("rel_rmse").value(c.m.rel_rmse);
-        j.key("nrmse").value(c.m.nrmse);
-        j.key("max_overshoot").value(c.m.max_ratio);
-        j.key("max_rel").value(c.m.max_rel);
-        j.key("reference_time_ms").value(c.ref_ms);
+        j.key("level").value(int(k));
+        j.key("virtual_level").value(lp.level);
+        j.key("size").value(chain_->size(int(k)));
+        j.key("roughness").value(lp.roughness);
+        j.key("samples").value(lp.samples);
+        j.key("trilinear").value(lp.trilinear);
+        if (c) {
+            j.key("texels_compared").value(c->texels);
+            j.key("rel_rmse").value(c->m.rel_rmse);
+            j.key("nrmse").value(c->m.nrmse);
+            j.key("max_overshoot").value(c->m.max_ratio);
+            j.key("max_rel").value(c->m.max_rel);
+            j.key("reference_time_ms").value(c->ref_ms);
+        } else { // --checks none
+            j.key("texels_compared").value(0);
+            for (const char* m : {"rel_rmse", "nrmse", "max_overshoot", "max_rel"}) j.key(m).null();
+        }
         j.end_object();
     }
     j.end_array();

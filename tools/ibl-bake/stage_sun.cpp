@@ -46,7 +46,11 @@ public:
                                            fmt(", omega %.3g sr", ext_.solid_angle) + fmt(", E %.4g", ibl::luminance(dvec3(ext_.irradiance))) +
                                            fmt(" (%.0f%% of E facing it)", 100.0 * ext_.share)
                                      : std::string("none: ") + ext_.reason();
-        return {{"sun", "extracted as a disk light (lights.json)", std::to_string(ext_.region_texels) + " texels", ms_, what}};
+        const std::string brief = ext_.found() ? fmt("E %.4g", ibl::luminance(dvec3(ext_.irradiance))) + fmt(", %.0f%% of E facing it", 100.0 * ext_.share) +
+                                                     fmt(", %.3g sr", ext_.solid_angle)
+                                               : std::string("none: ") + ext_.reason();
+        return {table_row{"sun", "extracted as a disk light (lights.json)", std::to_string(ext_.region_texels) + " texels", ms_, what}
+                    .compact("disk light, lights.json", brief)};
     }
     std::vector<std::string> notes_after() const override {
         if (required_ && !ext_.found()) return {std::string("warning: --extract-sun on, but no sun was found: ") + ext_.reason()};
