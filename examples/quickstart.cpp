@@ -27,7 +27,7 @@
 
 // The three products a renderer reads.
 struct ibl_products {
-    ibl::cubemap<float> chain; // prefiltered specular: level l holds roughness l / (levels - 1)
+    ibl::cubemap<float> chain;   // prefiltered specular: level l holds roughness l / (levels - 1)
     ibl::sh_coeffs<float, 3> sh; // radiance SH, 3 bands: the diffuse irradiance
     ibl::dfg_lut dfg;            // (A, B) on the uniform (n.v, roughness) grid
 };
