@@ -18,13 +18,13 @@ layout(location = 0) out vec4 o_color;
 #endif
 
 void main() {
-    ibl_specular_desc sd = ibl_specular_default(6, 0, 6);
+    ibl_specular_desc sd = ibl_specular_accurate(6, 0, 6);
     ibl_specular_desc tb = ibl_specular_textbook(6, 0, 6);
     ibl_specular_desc cr = ibl_specular_desc(6, 1, 5, IBL_MAPPING_FILAMENT, IBL_WEIGHT_POWER, 2.0, IBL_INTERP_CATMULL_ROM);
     ibl_specular_taps t = ibl_specular_lookup_taps(u_r, 6, cr);
     vec3 b = ibl_specular_blend(t, u_n, u_v, u_l, u_n, cr);
     vec3 ld = ibl_specular_lookup(u_chain, u_n, u_r, sd) + ibl_specular_lookup(u_chain, u_n, u_r, tb);
-    ibl_dfg_layout lay = ibl_dfg_layout_default();
+    ibl_dfg_layout lay = ibl_dfg_layout_remapped();
     vec3 abk = ibl_dfg_lookup(u_lut, dot(u_n, u_v), u_r, lay) + ibl_dfg_lookup(u_lut, 0.5, u_r, ibl_dfg_layout_uniform());
     vec3 e = ibl_sh_irradiance_over_pi(u_sh, u_n) + ibl_irradiance_map_over_pi(u_irradiance, u_n);
     ibl_material_terms m = ibl_resolve_material(ibl_make_material(vec3(0.8), 0.0, u_r));

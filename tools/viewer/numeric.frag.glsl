@@ -41,7 +41,7 @@ vec2 fis_dfg(int i) { return vec2(0.125 + float(i % 8) * 0.0625, float(i / 8) * 
 vec3 fis_f0(int i) { return vec3(0.04 + 0.0625 * float(i % 8), 0.5, 1.0); }
 ibl_specular_desc chain_desc(bool textbook) {
     if (textbook) return ibl_specular_textbook(4, 0, 4);
-    return ibl_specular_default(4, 0, 4);
+    return ibl_specular_accurate(4, 0, 4);
 }
 
 // ---- the occlusion rows (glsl_reference.cpp: so_point, bent_case_of, probe_texel) ----
@@ -137,7 +137,7 @@ vec4 runtime_row(int j, int i) {
                                               vec3(1.0), fis_dfg(i)), 0.0);
     if (j == 25) return vec4(ibl_specular_fis(u_chain, chain_desc(false), 16, 2.0, false, fis_n(i), fis_v(i), x, fis_f0(i),
                                               vec3(1.0), fis_dfg(i)), 0.0);
-    if (j == 26) return vec4(ibl_specular_lobe_taps2(u_chain, chain_desc(false), u_taps_a, u_taps_b, ibl_dfg_layout_default(),
+    if (j == 26) return vec4(ibl_specular_lobe_taps2(u_chain, chain_desc(false), u_taps_a, u_taps_b, ibl_dfg_layout_remapped(),
                                                      fis_n(i), fis_v(i), taps_r(i), fis_f0(i), vec3(1.0)), 0.0);
     if (j == 27) { // incidence tangent; every fourth case R = n (the frame's tangent)
         vec3 n = dir_of(i), r = i % 4 == 0 ? n : dir_of(63 - i);
@@ -150,7 +150,7 @@ vec4 row_value(int j, int i) {
     if (j >= 18) return runtime_row(j, i);
     float x = u64(i);
     if (j == 0) { // default taps in 6 levels
-        ibl_specular_taps t = ibl_specular_lookup_taps(x, 6, ibl_specular_default(6, 0, 6));
+        ibl_specular_taps t = ibl_specular_lookup_taps(x, 6, ibl_specular_accurate(6, 0, 6));
         return vec4(t.lod, t.weight.x, t.weight.y, float(t.level.x));
     }
     if (j == 1) { // textbook taps in 5 levels
@@ -163,14 +163,14 @@ vec4 row_value(int j, int i) {
         return t.weight;
     }
     if (j == 3) { // geometric blend of two values (one channel 0: linear there)
-        ibl_specular_desc d = ibl_specular_default(6, 0, 6);
+        ibl_specular_desc d = ibl_specular_accurate(6, 0, 6);
         ibl_specular_taps t = ibl_specular_lookup_taps(x, 6, d);
         vec3 a = vec3(0.25 + float(i) * 0.03125, 3.0, 0.0), b = vec3(1.5, 0.125 + float(i) * 0.015625, 2.0);
         return vec4(ibl_specular_blend(t, a, b, vec3(0.0), vec3(0.0), d), t.weight.y);
     }
     if (j == 4) { // DFG sampler coordinates, default and uniform layouts, N = 128
         float r = 1.0 - x;
-        return vec4(ibl_dfg_lut_coord(x, r, 128, ibl_dfg_layout_default()),
+        return vec4(ibl_dfg_lut_coord(x, r, 128, ibl_dfg_layout_remapped()),
                     ibl_dfg_lut_coord(x, r, 128, ibl_dfg_layout_uniform()));
     }
     if (j == 5) { // SH: E/pi from nine constants

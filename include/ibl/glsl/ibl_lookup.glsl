@@ -48,8 +48,9 @@ struct ibl_specular_desc {
     int interpolation;     // IBL_INTERP_*
 };
 
-// The default of the library (and of ibl-bake): t linear in log r, geometric blend.
-ibl_specular_desc ibl_specular_default(int virtual_levels, int first_level, int stored_levels) {
+// The accurate lookup (specular_lookup_desc::accurate(), ibl-bake --preset accurate): t linear in
+// log r, geometric blend. The library's default is ibl_specular_textbook.
+ibl_specular_desc ibl_specular_accurate(int virtual_levels, int first_level, int stored_levels) {
     return ibl_specular_desc(virtual_levels, first_level, stored_levels, IBL_MAPPING_LINEAR, IBL_WEIGHT_LOG, 2.0,
                              IBL_INTERP_GEOMETRIC);
 }
@@ -176,9 +177,10 @@ struct ibl_dfg_layout {
     bool edge_aligned; // true: first / last texel centres at axis coordinates 0 and 1
 };
 
-// The library's default: cbrt(n.v) x sqrt(r), edge aligned.
-ibl_dfg_layout ibl_dfg_layout_default() { return ibl_dfg_layout(IBL_DFG_AXIS_CBRT, IBL_DFG_AXIS_SQRT, true); }
-// The textbook table: texture(lut, vec2(n.v, r)).
+// The remapped table (dfg_lut_layout::remapped(), ibl-bake --preset accurate): cbrt(n.v) x sqrt(r),
+// edge aligned.
+ibl_dfg_layout ibl_dfg_layout_remapped() { return ibl_dfg_layout(IBL_DFG_AXIS_CBRT, IBL_DFG_AXIS_SQRT, true); }
+// The textbook table (the default of the library and of ibl-bake): texture(lut, vec2(n.v, r)).
 ibl_dfg_layout ibl_dfg_layout_uniform() { return ibl_dfg_layout(IBL_DFG_AXIS_LINEAR, IBL_DFG_AXIS_LINEAR, false); }
 
 // The axis coordinate in [0, 1] of a value in [0, 1] (dfg_axis_coord).
