@@ -6,7 +6,8 @@
 //   E(mu, r) = integral over the hemisphere of f(v, l) n.l d(omega_l),  f = D V (F = 1)
 //   estimator: (1/N) sum_i M::sample_weight(n.v, n.l_i, n.h_i, v.h_i, r),  h_i ~ D(h) n.h
 //
-// Until the bake tool exists this is what `scripts/main.sh` runs.
+// A study kept for comparison: the bake tool (tools/ibl-bake, run by scripts/main.sh) reports the
+// DFG table's exact quadrature instead.
 #include <ibl/ibl.hpp>
 
 #include <chrono>
