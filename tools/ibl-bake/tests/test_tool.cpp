@@ -640,7 +640,7 @@ TEST_CASE("report: report.json defines every metric it uses and records the chec
                 CHECK(m[k].str.size() > 20);
             }
         CHECK(metric_keys > 10);
-        for (const auto& [k, def] : m.fields) CHECK_MESSAGE(keys.count(k) == 1, k); // only what the file uses
+        for (const auto& field : m.fields) CHECK_MESSAGE(keys.count(field.first) == 1, field.first); // only what the file uses
     }
 }
 
