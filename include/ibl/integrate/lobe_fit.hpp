@@ -381,7 +381,11 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     }
     out.count = n_taps;
     detail::taps_from_params(x.data(), n_taps, vmax, out.taps);
-    std::sort(out.taps.begin(), out.taps.begin() + n_taps, [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
+    { // sorted through a vector: g++ 12 -O3 reads std::sort over a prefix of the array as out of bounds
+        std::vector<lobe_tap> sorted(out.taps.begin(), out.taps.begin() + n_taps);
+        std::sort(sorted.begin(), sorted.end(), [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
+        std::copy(sorted.begin(), sorted.end(), out.taps.begin());
+    }
     out.l1 = o.leak_weight > 0.0 ? detail::mixture_l1(pts, out.taps, n_taps, w, o.level_roughness) : best;
     return out;
 }
