@@ -4,7 +4,10 @@
 // over the whole sphere (p from the model's D and V, normalised by dfg_exact), the fit's exact
 // answer at n.v = 1 for a G1 chain (the lobe is the kernel there), the fit against the moment match
 // and against fewer taps at grazing views, the tables (A, B equal to the DFG table, weights
-// summing to 1, the mirror row) and the white furnace of both runtime models.
+// summing to 1, the mirror row) and the white furnace of both runtime models; the two-part lobe
+// model: its parts' weights and albedos, the B part's kernel against the whole lobe's and the
+// split sum's, its tables, and its exact limits (white furnace for any F0, F90 = 0 equal to the
+// one-kernel model, the mirror row equal to the split sum, the effective LD's split-sum form).
 //
 // Tolerances: a quadrature's own error is bounded by the change when its resolution doubles
 // (smooth integrands, midpoint rules of order 2: the finer result's error is about a third of that
@@ -14,10 +17,12 @@
 #include <doctest/doctest.h>
 
 #include <ibl/brdf/model.hpp>
+#include <ibl/env/cube_geometry.hpp>
 #include <ibl/integrate/dfg.hpp>
 #include <ibl/integrate/lobe_fit.hpp>
 #include <ibl/runtime.hpp>
 
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -234,5 +239,125 @@ TEST_CASE("lobe fit: a kernel's mass below the horizon against a direct sphere q
                                            std::fabs(e - ibl::detail::ld_kernel_mass_below(a, r, ibl::ld_weight::g1, 2048)));
             INFO("angle " << a << " r " << r << " quadrature " << q2 << " mass_below " << e);
             CHECK(std::fabs(e - q2) <= std::fabs(q2 - q1) + spread + 1e-7);
+        }
+}
+
+// ---- the two-part lobe model (make_lobe_pair_lut, specular_lobe_pair) ----------------------------
+
+/// A chain whose radiance varies with direction (every level the same function, so that a lookup
+/// at any roughness reads it at its direction): L = 1 + 0.5 x + 0.25 y^2 per channel scale.
+ibl::cubemap<float> varying_chain(int size = 16, int levels = 5) {
+    ibl::cubemap<float> c(size, levels);
+    for (int l = 0; l < levels; ++l) {
+        const int s = c.size(l);
+        c.fill(l, [&](int f, int x, int y) {
+            const f3 d = ibl::cube_texel_direction<float>(f, x, y, s);
+            return f3(1.0f + 0.5f * d.x + 0.25f * d.y * d.y);
+        });
+    }
+    c.update_borders();
+    return c;
+}
+
+TEST_CASE("two-part lobe: the parts' Schlick weights sum to 1 and their albedos are the DFG terms") {
+    for (const double vh : {0.0, 0.3, 0.9, 1.0})
+        CHECK(ibl::lobe_fresnel_part_weight(ibl::lobe_fresnel_part::a, vh) + ibl::lobe_fresnel_part_weight(ibl::lobe_fresnel_part::b, vh) ==
+              doctest::Approx(1.0).epsilon(1e-15));
+    for (const double mu : {0.2, 0.7})
+        for (const double r : {0.3, 0.8}) {
+            const ibl::vec2<double> ab = ibl::dfg_exact<model>(mu, r);
+            double e[2] = {0.0, 0.0}, e2[2] = {0.0, 0.0};
+            for (int part = 0; part < 2; ++part)
+                for (const std::uint32_t q : {128u, 256u}) {
+                    const ibl::detail::lobe_points p = ibl::detail::make_lobe_points<model>(
+                        mu, r, q, part == 0 ? ibl::lobe_fresnel_part::a : ibl::lobe_fresnel_part::b);
+                    (q == 128u ? e : e2)[part] = p.weight_sum / (double(q) * double(q));
+                }
+            INFO("mu " << mu << " r " << r << " A " << ab.x << " " << e2[0] << " B " << ab.y << " " << e2[1]);
+            CHECK(std::fabs(e2[0] - ab.x) <= std::fabs(e2[0] - e[0]) + 1e-4);
+            CHECK(std::fabs(e2[1] - ab.y) <= std::fabs(e2[1] - e[1]) + 1e-4);
+        }
+}
+
+TEST_CASE("two-part lobe: the B part's own kernel is closer to it than the whole lobe's kernel and the split sum's (R, r)") {
+    for (const double mu : {0.15, 0.5, 0.9})
+        for (const double r : {0.3, 0.5, 0.7}) {
+            ibl::lobe_fit_options ob;
+            ob.part = ibl::lobe_fresnel_part::b;
+            const ibl::lobe_mixture fb = ibl::fit_specular_lobe<model>(mu, r, ibl::ld_weight::g1, ob);
+            const ibl::lobe_mixture fw = ibl::fit_specular_lobe<model>(mu, r, ibl::ld_weight::g1);
+            const ibl::detail::lobe_points pb = ibl::detail::make_lobe_points<model>(mu, r, 32, ibl::lobe_fresnel_part::b);
+            std::array<ibl::lobe_tap, ibl::lobe_max_taps> split{};
+            split[0] = {std::acos(mu), r, 1.0};
+            const double l1_b = ibl::detail::mixture_l1(pb, fb.taps, 1, ibl::ld_weight::g1, {});
+            const double l1_w = ibl::detail::mixture_l1(pb, fw.taps, 1, ibl::ld_weight::g1, {});
+            const double l1_s = ibl::detail::mixture_l1(pb, split, 1, ibl::ld_weight::g1, {});
+            INFO("mu " << mu << " r " << r << " B fit " << l1_b << " whole kernel " << l1_w << " (R, r) " << l1_s);
+            CHECK(l1_b < l1_w);
+            CHECK(l1_b < l1_s);
+            CHECK(fb.taps[0].angle >= 0.0);
+            CHECK(fb.taps[0].angle <= ibl::half_pi_v<double>);
+        }
+}
+
+TEST_CASE("two-part lobe: the table's A part is the one-kernel table; the B table's mirror row sits at R") {
+    const ibl::dfg_lut_layout lay = ibl::dfg_lut_layout::remapped();
+    const ibl::lobe_pair_lut p = ibl::make_lobe_pair_lut<model>(6, lay, ibl::ld_weight::g1, {}, ibl::serial_executor{});
+    const ibl::lobe_lut l = ibl::make_lobe_lut_fitted<model>(6, lay, ibl::ld_weight::g1, {}, ibl::serial_executor{});
+    REQUIRE(p.a.data.size() == l.data.size());
+    REQUIRE(p.b.data.size() == l.data.size());
+    for (std::size_t k = 0; k < l.data.size(); ++k) CHECK(p.a.data[k] == l.data[k]);
+    CHECK(p.b.size == 6u);
+    CHECK(p.b.layout == lay);
+    for (std::uint32_t i = 0; i < 6; ++i) { // row r = 0: at R (1), roughness 0
+        CHECK(p.b.data[i * 4] == 1.0f);
+        CHECK(p.b.data[i * 4 + 1] == 0.0f);
+    }
+    for (std::size_t k = 0; k < 36; ++k) {
+        CHECK(p.b.data[k * 4 + 1] >= 0.0f);
+        CHECK(p.b.data[k * 4 + 1] <= 1.0f);
+        CHECK(p.b.data[k * 4 + 2] == 0.0f);
+        CHECK(p.b.data[k * 4 + 3] == 0.0f);
+    }
+}
+
+TEST_CASE("two-part lobe: white furnace, F90 = 0 is the one-kernel model, the mirror is the split sum") {
+    const ibl::dfg_lut_layout lay = ibl::dfg_lut_layout::remapped();
+    const ibl::lobe_pair_lut p = ibl::make_lobe_pair_lut<model>(8, lay, ibl::ld_weight::g1, {}, ibl::serial_executor{});
+    const ibl::cubemap<float> flat = constant_chain(1.5f), chain = varying_chain();
+    const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
+    const d3 n = glm::normalize(d3(-0.2, 0.9, 0.3));
+    const ibl::frame<double> fr = ibl::make_frame(n);
+    const f3 dielectric(0.04f), metal(0.95f, 0.64f, 0.54f);
+    for (const double mu : {0.15, 0.5, 1.0})
+        for (const double r : {0.0, 0.3, 0.7}) {
+            const double s = std::sqrt((1.0 - mu) * (1.0 + mu));
+            const f3 v(fr.to_world(d3(0.6 * s, 0.8 * s, mu)));
+            const ibl::vec4<float> ab = ibl::lobe_lut_lookup(p.a, float(mu), float(r));
+            for (const f3& f0 : {dielectric, metal}) {
+                INFO("mu " << mu << " r " << r << " f0 " << f0.y);
+                // a constant environment: exactly (F0 A + F90 B) L
+                const f3 w = ibl::specular_lobe_pair(flat, sd, p.a, p.b, f3(n), v, float(r), f0, f3(1.0f));
+                for (int c = 0; c < 3; ++c)
+                    CHECK(double(w[c]) == doctest::Approx(1.5 * double(f0[c] * ab.x + ab.y)).epsilon(16 * feps));
+                // F90 = 0: only the A part, read by the one-kernel table's kernel
+                const f3 a2 = ibl::specular_lobe_pair(chain, sd, p.a, p.b, f3(n), v, float(r), f0, f3(0.0f));
+                const f3 a1 = ibl::specular_lobe(chain, sd, p.a, f3(n), v, float(r), f0, f3(0.0f));
+                for (int c = 0; c < 3; ++c) CHECK(double(a2[c]) == doctest::Approx(double(a1[c])).epsilon(4 * feps));
+                // the effective LD in the split sum's form gives the same specular
+                const f3 nf(n);
+                const f3 r_dir = 2.0f * glm::dot(nf, v) * nf - v;
+                const ibl::vec4<float> pb = ibl::lobe_lut_lookup(p.b, float(mu), float(r));
+                const f3 ld_a = ibl::specular_lookup(chain, ibl::lerp_direction(nf, r_dir, ab.z), ab.w, sd);
+                const f3 ld_b = ibl::specular_lookup(chain, ibl::lobe_pair_direction_b(nf, r_dir, pb.x, float(mu)), pb.y, sd);
+                const f3 ld = ibl::lobe_pair_ld(ld_a, ld_b, f0, f3(1.0f), ibl::vec2<float>(ab.x, ab.y));
+                const f3 full = ibl::specular_lobe_pair(chain, sd, p.a, p.b, nf, v, float(r), f0, f3(1.0f));
+                for (int c = 0; c < 3; ++c)
+                    CHECK(double(ld[c] * (f0[c] * ab.x + ab.y)) == doctest::Approx(double(full[c])).epsilon(16 * feps));
+                if (r == 0.0) { // the mirror row: both kernels at R with roughness 0, the split sum
+                    const f3 split = ibl::specular_lookup(chain, r_dir, 0.0f, sd) * (f0 * ab.x + f3(ab.y));
+                    for (int c = 0; c < 3; ++c) CHECK(double(full[c]) == doctest::Approx(double(split[c])).epsilon(16 * feps));
+                }
+            }
         }
 }

@@ -292,6 +292,52 @@ vec3<float> specular_lobe_taps(const cubemap<float>& chain, const specular_looku
     return ld * split_sum_albedo(f0, f90, vec2<float>(p[0], p[1]));
 }
 
+// ---- the two-part lobe model ----------------------------------------------------------------------
+
+/// The effective LD of the two-part model for a material (header): per channel
+/// (F0 A LD_a + F90 B LD_b) / (F0 A + F90 B) (LD_a where that albedo is 0), so that the split
+/// sum's form LD (F0 A + F90 B), e.g. shade.hpp's ambient, gives F0 A LD_a + F90 B LD_b.
+template <class T>
+IBL_FUNC vec3<T> lobe_pair_ld(const vec3<T>& ld_a, const vec3<T>& ld_b, const vec3<T>& f0, const vec3<T>& f90,
+                              const vec2<T>& ab) noexcept {
+    vec3<T> out;
+    for (int c = 0; c < 3; ++c) {
+        const T wa = f0[c] * ab.x, wb = f90[c] * ab.y, den = wa + wb;
+        out[c] = den > T(0) ? (wa * ld_a[c] + wb * ld_b[c]) / den : ld_a[c];
+    }
+    return out;
+}
+
+/// The direction of the two-part model's B kernel (header): at angle f acos(n.v) from n towards R
+/// in the plane of incidence, cos(a) n + sin(a) t with t = incidence_tangent(n, R) (a clamped to
+/// [0, pi/2]: the kernel stays above n's horizon).
+template <class T> IBL_FUNC vec3<T> lobe_pair_direction_b(const vec3<T>& n, const vec3<T>& r_dir, T stored, T n_dot_v) noexcept {
+    using std::cos;
+    using std::sin;
+    using std::sqrt;
+    T a = lobe_tap_angle(stored, n_dot_v);
+    a = a < T(0) ? T(0) : (a > half_pi_v<T> ? half_pi_v<T> : a);
+    const vec3<T> d = cos(a) * n + sin(a) * incidence_tangent(n, r_dir);
+    return d * (T(1) / sqrt(glm::dot(d, d)));
+}
+
+/// The two-part lobe model (header): with (A, B, s_A, r_A) = lobe_lut_lookup(a, n.v, r) and
+/// (f_B, r_B) = lobe_lut_lookup(b, n.v, r) (integrate/lobe_fit.hpp make_lobe_pair_lut)
+///     Lo_s ~ F0 A LD(normalize(lerp(n, R, s_A)), r_A) + F90 B LD(d_B, r_B)
+/// d_B = lobe_pair_direction_b(n, R, f_B, n.v). Cost: two chain lookups and two RGBA table taps.
+template <class Table>
+vec3<float> specular_lobe_pair(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& a, const Table& b,
+                               const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
+                               const vec3<float>& f90) {
+    const float n_dot_v = saturate(glm::dot(n, v));
+    const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
+    const vec4<float> pa = lobe_lut_lookup(a, n_dot_v, roughness);
+    const vec4<float> pb = lobe_lut_lookup(b, n_dot_v, roughness);
+    const vec3<float> ld_a = specular_lookup(chain, lerp_direction(n, r_dir, pa.z), pa.w, sd);
+    const vec3<float> ld_b = specular_lookup(chain, lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+    return f0 * pa.x * ld_a + f90 * pa.y * ld_b;
+}
+
 } // namespace ibl
 
 #endif // IBL_DETAIL_CXX20

@@ -5,7 +5,7 @@ SwiftShader's WebGL2), compared with the C++.
   preview  bakes a small folder with the built ibl-bake (--size 32 --quality low), serves the
            repository's tools/viewer/ and include/ibl/glsl/ and the folder on 127.0.0.1, lets
            tools/viewer/index.html?test=preview render ibl-bake's preview grid from specular.ktx2,
-           dfg.hpp, lobe_lut.hpp (the default runtime model; --preset filament / gltf bake the
+           dfg.hpp, lobe_lut.hpp and lobe_lut_b.hpp (the lobe model; --preset filament / gltf bake the
            split sum; --runtime taps2 the two-tap table, lobe_taps.hpp), sh.json and report.json, and compares its pixels with the bake's own
            preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
@@ -300,6 +300,13 @@ def compare_preview(bake_dir, result):
         raise RuntimeError(f"the page shaded with {info.get('runtime_model')!r}, the bake's model is {expected_model!r}")
     if expected_model == "lobe" and info.get("lobe_texture") != "RGBA32F":
         raise RuntimeError("the lobe LUT is not an RGBA32F texture: no bound derived")
+    # The two-part lobe model (runtime_model.parts = 2): lobe_lut_b.hpp's floats as a second RGBA32F
+    # texture; its LD (F0 A LD_a + F90 B LD_b) / (F0 A + F90 B) is a convex combination of two chain
+    # reads, which keeps the chain's relative bound.
+    if expected_model == "lobe":
+        parts = json.load(open(os.path.join(bake_dir, "report.json")))["plan"]["runtime"]["runtime_model"].get("parts", 1)
+        if info.get("lobe_parts") != parts:
+            raise RuntimeError(f"the page shaded the lobe model with {info.get('lobe_parts')} part(s), the bake has {parts}")
     # The two-tap model (runtime_model "taps2"): lobe_taps.hpp's exact floats in two RGBA32F
     # textures; the taps' directions cos(a) n + sin(a) t are formed in float on both sides and LD
     # is their weighted mean, a convex combination of chain reads that keeps the chain's relative
@@ -350,7 +357,7 @@ def compare_preview(bake_dir, result):
     print(f"chain {info['chain_format']} levels {info['chain_levels']}, DFG texture {info['lut_texture']} "
           f"{info['lut_size']}^2, exposure {info['exposure']:.8g}, {ss}x{ss} samples per pixel")
     print(f"runtime model {info['runtime_model']}" +
-          (f" (lobe LUT {info['lobe_texture']} {info['lobe_size']}^2)" if info['runtime_model'] == "lobe" else "") +
+          (f" (lobe LUT {info['lobe_texture']} {info['lobe_size']}^2, {info['lobe_parts']} part(s))" if info['runtime_model'] == "lobe" else "") +
           (f" (two-tap table 2 x {info['taps_texture']} {info['taps_size']}^2)" if info['runtime_model'] == "taps2" else ""))
     print(f"sun: " + (f"omega {info['sun']['solidAngle']:.6g} sr, specular term's eps {sun_eps:.3g}" if info.get("sun") else "none"))
     print(f"derived: eps = {eps:.3g} relative, max 8-bit slope {slope:.2f} per unit ln L, delta {delta:.3f} "

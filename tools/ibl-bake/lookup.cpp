@@ -153,6 +153,12 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         const ibl::vec4<double> p = v.lobe_params(unit_interval(a[0]), unit_interval(a[1]));
         return fmt9(p.x) + " " + fmt9(p.y) + " " + fmt9(p.z) + " " + fmt9(p.w);
     }
+    if (word == "lobe_b") {
+        need(2);
+        if (!b.has_lobe_b) throw std::invalid_argument("the bake has no B-part lobe table (bake with --runtime lobe)");
+        const ibl::vec2<double> p = v.lobe_b_params(unit_interval(a[0]), unit_interval(a[1]));
+        return fmt9(p.x) + " " + fmt9(p.y);
+    }
     if (word == "taps") {
         need(2);
         if (!b.has_taps) throw std::invalid_argument("the bake has no two-tap table (bake with --runtime taps2)");
@@ -163,7 +169,7 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
         }
         return s;
     }
-    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe, taps)");
+    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe, lobe_b, taps)");
 }
 
 } // namespace
@@ -180,6 +186,7 @@ product_view baked_folder::view() const {
     v.dfg_layout = dfg_layout;
     v.sun = sun ? &*sun : nullptr;
     v.lobe = has_lobe ? &lobe : nullptr;
+    v.lobe_b = has_lobe_b ? &lobe_b : nullptr;
     v.taps = has_taps ? &taps : nullptr;
     v.weight = weight;
     return v;
@@ -233,6 +240,15 @@ void load_runtime_model(baked_folder& b, const json_value& rt, const std::string
     b.lobe.layout = b.dfg_layout;
     check_layout_attribute(dir + "/lobe_lut.exr", b.dfg_layout);
     b.has_lobe = true;
+    // the two-part model (plan.runtime.runtime_model.parts = 2); a bake before it: one kernel
+    if (!m->find("parts") || m->find("parts")->number != 2.0) return;
+    const image_rgba32f ib = read_exr_rgba(dir + "/lobe_lut_b.exr");
+    if (ib.width != img.width || ib.height != img.height)
+        throw std::runtime_error(dir + "/lobe_lut_b.exr: not the size of lobe_lut.exr");
+    b.lobe_b = b.lobe;
+    b.lobe_b.data = ib.rgba;
+    check_layout_attribute(dir + "/lobe_lut_b.exr", b.dfg_layout);
+    b.has_lobe_b = true;
 }
 } // namespace
 

@@ -1,7 +1,7 @@
 #pragma once
 // tools/ibl-bake/lookup.hpp — `ibl-bake --lookup DIR`: answers queries about a bake folder exactly
 // as the documented runtime code does, from the files in DIR (report.json's plan.runtime,
-// specular.ktx2, dfg.exr, lobe_lut.exr or lobe_taps_a.exr and lobe_taps_b.exr, sh.json or
+// specular.ktx2, dfg.exr, lobe_lut.exr and lobe_lut_b.exr or lobe_taps_a.exr and lobe_taps_b.exr, sh.json or
 // irradiance.ktx2).
 //
 // Queries on stdin, one per line, one answer line each (numbers separated by spaces; lines that
@@ -18,11 +18,15 @@
 //   dfg_sheen NV R              -> E       the sheen albedo lookup (bilinear, texel centres)
 //   lobe NV R                   -> A B s r_eff   the lobe LUT lookup (a --runtime lobe bake;
 //                                 ibl::lobe_lut_lookup in the DFG layout)
+//   lobe_b NV R                 -> f_B r_B       the lobe model's B-part table (lobe_lut_b.exr), the
+//                                 same lookup
 //   taps NV R                   -> A B a0 r0 w0 a1 r1 w1   the two-tap table's bilinear read (a
 //                                 --runtime taps2 bake; in the DFG layout, as
 //                                 ibl::specular_lobe_taps reads it; angles over pi/2)
 // shade uses the bake's runtime model (report.json plan.runtime.runtime_model): lobe reads the
-// chain at normalize(lerp(n, R, s)) and r_eff with the lobe LUT's (A, B); taps2 at the two taps
+// chain at normalize(lerp(n, R, s)) and r_eff for F0 A and at the B kernel (f_B, r_B) for F90 B
+// (ibl::specular_lobe_pair; a bake without runtime_model.parts = 2: one kernel, LD(normalize(
+// lerp(n, R, s)), r_eff) (F0 A + F90 B)); taps2 at the two taps
 // (cos(a_k) n + sin(a_k) t, r_k; their weighted mean) with the table's (A, B); split-sum at R
 // and r with the DFG table's. specular and dfg answer the chain and the DFG table themselves.
 // With a sun in lights.json the answers are about the whole environment: specular adds the sun's
@@ -56,6 +60,8 @@ struct baked_folder {
     bool has_sheen = false;
     ibl::lobe_lut lobe;                         ///< lobe_lut.exr (runtime model lobe)
     bool has_lobe = false;
+    ibl::lobe_lut lobe_b;                       ///< lobe_lut_b.exr (f_B, r_B: the lobe model's B part)
+    bool has_lobe_b = false;
     ibl::lobe_taps_lut taps;                    ///< lobe_taps_a.exr + lobe_taps_b.exr (runtime model taps2)
     bool has_taps = false;
     ibl::ld_weight weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight (plan.runtime.ld_weight)

@@ -126,7 +126,8 @@ struct bake_context {
     // products (the product stages)
     std::optional<ibl::cubemap<float>> chain; ///< the stored levels of plan.specular
     std::optional<ibl::dfg_lut> lut;
-    std::optional<ibl::lobe_lut> lobe; ///< the lobe LUT (--runtime lobe)
+    std::optional<ibl::lobe_lut> lobe; ///< the lobe LUT (--runtime lobe): (A, B, s_A, r_A)
+    std::optional<ibl::lobe_lut> lobe_b; ///< its B-part kernel table (f_B, r_B, 0, 0)
     std::optional<ibl::lobe_taps_lut> taps; ///< the two-tap table (--runtime taps2)
     diffuse_data diffuse;
     product_times measured; ///< filled by the pipeline after each product stage

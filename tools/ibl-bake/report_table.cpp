@@ -139,6 +139,11 @@ const std::vector<std::pair<std::string, std::string>>& metric_definitions() {
                           "directions"},
         {"rel", "Y_model / Y_reference - 1: the signed relative error of the shaded luminance in one view"},
         {"mean_abs_rel", "the mean over the views of |Y_model / Y_reference - 1|, Y the shaded luminance"},
+        {"mean_abs_rel_std_error", "the standard error of mean_abs_rel from the MIS reference's own noise: sqrt(sum over "
+                                   "the views of ((1 + rel) se_rel)^2) / views"},
+        {"split_sum_mean_abs_rel", "mean_abs_rel of the plain split sum (LD(R, r) (F0 A + F90 B)) at the same views, the "
+                                   "figure the runtime model is compared with ('excess' = model - split sum, 'noise' = 2 "
+                                   "sqrt(se_model^2 + se_split^2); 'worse' when excess > noise)"},
         {"max_abs_rel", "the largest over the views of |Y_model / Y_reference - 1|, Y the shaded luminance"},
         {"reference_rel_std_error", "the Monte Carlo reference's own relative standard error (its noise): an error below "
                                     "about twice it is not resolved"},

@@ -41,7 +41,7 @@ dvec3 product_view::ld(const dvec3& r_dir, double roughness) const {
 }
 
 dvec3 product_view::shade(const ibl::pbr_shader<double>& shader, const dvec3& n, const dvec3& v) const {
-    dvec3 lo = shader.ambient(std::clamp(glm::dot(n, v), 0.0, 1.0), sample(n, v, shader.m.roughness));
+    dvec3 lo = shader.ambient(std::clamp(glm::dot(n, v), 0.0, 1.0), sample(n, v, shader.m.roughness, shader.m.f0, shader.m.f90));
     if (sun) lo += ibl::shade_disk(n, v, *sun, shader.m);
     return lo;
 }
@@ -77,6 +77,11 @@ ibl::vec4<double> product_view::lobe_params(double n_dot_v, double roughness) co
     return ibl::vec4<double>(ibl::lobe_lut_lookup(*lobe, float(n_dot_v), float(roughness)));
 }
 
+ibl::vec2<double> product_view::lobe_b_params(double n_dot_v, double roughness) const {
+    const ibl::vec4<float> p = ibl::lobe_lut_lookup(*lobe_b, float(n_dot_v), float(roughness));
+    return ibl::vec2<double>(p.x, p.y);
+}
+
 std::array<float, 8> product_view::taps_params(double n_dot_v, double roughness) const {
     const ibl::vec2<float> st = ibl::dfg_lut_coord(float(n_dot_v), float(roughness), taps->size, dfg_layout);
     std::array<float, 8> p{};
@@ -106,7 +111,8 @@ dvec3 taps_ld(const product_view& pv, const std::array<float, 8>& p, const dvec3
 }
 } // namespace
 
-ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness) const {
+ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, double roughness, const dvec3& f0,
+                                             const dvec3& f90) const {
     const double n_dot_v = std::clamp(glm::dot(n, v), 0.0, 1.0);
     const dvec3 r_dir = 2.0 * glm::dot(n, v) * n - v;
     ibl::ibl_sample<double> s;
@@ -117,10 +123,15 @@ ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, dou
         s.dfg = ibl::vec2<double>(p[0], p[1]);
         return s;
     }
-    if (lobe) { // as ibl::specular_lobe: the direction in float, the chain at r_eff
+    if (lobe) { // as ibl::specular_lobe(_pair): the directions in float, the chain at r_eff (r_A, r_B)
         const ibl::vec4<double> p = lobe_params(n_dot_v, roughness);
         s.ld = ld(dvec3(ibl::lerp_direction(fvec3(n), fvec3(r_dir), float(p.z))), p.w);
         s.dfg = ibl::vec2<double>(p.x, p.y);
+        if (lobe_b) {
+            const ibl::vec2<double> pb = lobe_b_params(n_dot_v, roughness);
+            const fvec3 d_b = ibl::lobe_pair_direction_b(fvec3(n), fvec3(r_dir), float(pb.x), float(n_dot_v));
+            s.ld = ibl::lobe_pair_ld(s.ld, ld(dvec3(d_b), pb.y), f0, f90, s.dfg);
+        }
         return s;
     }
     s.ld = ld(r_dir, roughness);
@@ -173,8 +184,14 @@ void json_runtime_model(json_writer& j, const runtime_model& rm) {
     if (rm.name == "lobe") {
         j.key("lut").value("lobe_lut.exr (lobe_lut.hpp)").key("lut_size").value(rm.lobe_lut_size);
         j.key("channels").value("R = A, G = B, B = s, A = r_eff");
-        j.key("rule").value("(A, B, s, r_eff) = lobe LUT at (n.v, r) in the DFG layout (bilinear); specular = "
-                            "LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) (ibl::specular_lobe)");
+        j.key("lut_b").value("lobe_lut_b.exr (lobe_lut_b.hpp)");
+        j.key("channels_b").value("R = f_B (the B kernel's angle from n towards R over acos(n.v)), G = r_B, B = 0, A = 0");
+        j.key("parts").value(2);
+        j.key("rule").value("(A, B, s, r_eff) = lobe LUT and (f_B, r_B) = lobe_lut_b at (n.v, r) in the DFG layout "
+                            "(bilinear); t = the tangent of n towards R, a_B = min(f_B acos(n.v), pi/2); specular = "
+                            "F0 A LD(normalize(lerp(n, R, s)), r_eff) + F90 B LD(cos(a_B) n + sin(a_B) t, r_B) "
+                            "(ibl::specular_lobe_pair: the A part of the lobe by the whole lobe's kernel, the Fresnel B "
+                            "part by its own)");
     } else if (rm.name == "taps2") {
         j.key("lut").value("lobe_taps_a.exr, lobe_taps_b.exr (lobe_taps.hpp)").key("lut_size").value(rm.lobe_lut_size);
         j.key("channels").value("lobe_taps_a: R = A, G = B, B = angle0 / acos(n.v), A = roughness0; lobe_taps_b: R = weight0, "
@@ -240,6 +257,7 @@ product_view baked_view(const bake_context& ctx) {
     v.diffuse = &ctx.diffuse;
     v.sun = ctx.sun ? &*ctx.sun : nullptr;
     v.lobe = ctx.lobe ? &*ctx.lobe : nullptr;
+    v.lobe_b = ctx.lobe_b ? &*ctx.lobe_b : nullptr;
     v.taps = ctx.taps ? &*ctx.taps : nullptr;
     v.weight = ld_weight_named(ctx.opt.ld_weight);
     return v;

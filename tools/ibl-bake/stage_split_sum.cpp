@@ -7,7 +7,11 @@
 // distribution, no split sum) with the same diffuse weighting, for a dielectric and a metal at
 // three roughness values, seen in three views about the brightest direction. With the lobe or
 // taps2 model the plain split sum (LD(R, r) DFG) of the same products is measured too, against
-// the same reference: the report shows both.
+// the same reference: the report shows both, each mean |rel| with its standard error from the
+// reference's (each view's |rel| moves by (1 + rel) times the reference's relative standard
+// error; views independent), and flags the runtime model as worse than the split sum only where
+// its mean |rel| exceeds the split sum's by more than the noise: two standard errors of the
+// difference, sqrt(se_runtime^2 + se_split^2).
 
 #include "stages.hpp"
 
@@ -59,18 +63,28 @@ struct view_result {
 struct model_result {
     std::vector<view_result> views;
     double max_abs_rel = 0.0, mean_abs_rel = 0.0;
+    double mean_abs_rel_var = 0.0; ///< variance of mean_abs_rel from the reference's noise
 
     void add(const view_result& v, std::size_t count) {
         views.push_back(v);
         max_abs_rel = std::max(max_abs_rel, std::fabs(v.rel));
         mean_abs_rel += std::fabs(v.rel) / double(count);
+        const double s = (1.0 + v.rel) * v.se_rel / double(count);
+        mean_abs_rel_var += s * s;
     }
+    double mean_abs_rel_se() const { return std::sqrt(mean_abs_rel_var); }
 };
 struct split_result {
     std::string material;
     double roughness = 0.0;
     model_result runtime, plain; ///< the runtime model; the plain split sum (the same with --runtime split-sum)
     double ms = 0.0;
+
+    /// The runtime model's mean |rel| minus the split sum's, the noise it is judged against (two
+    /// standard errors of the difference) and whether it exceeds it.
+    double excess() const { return runtime.mean_abs_rel - plain.mean_abs_rel; }
+    double noise() const { return 2.0 * std::sqrt(runtime.mean_abs_rel_var + plain.mean_abs_rel_var); }
+    bool worse() const { return excess() > noise(); }
 };
 
 class split_sum_stage final : public stage {
@@ -162,17 +176,21 @@ std::vector<table_row> split_sum_stage::rows() const {
     auto name_of = [](const std::string& model) { return std::string(model == "split-sum" ? "split sum " : model == "lobe" ? "lobe lut " : "taps2 "); };
     auto method_of = [](const std::string& model) {
         return model == "split-sum" ? "baked LD+DFG+SH vs MIS reference"
-               : model == "lobe"    ? "baked LD(lerp(n,R,s), r_eff)+lobe LUT+SH vs MIS"
+               : model == "lobe"    ? "baked F0 A LD(d_A)+F90 B LD(d_B)+SH vs MIS"
                                     : "baked 2 x LD(d_k, r_k)+taps LUT+SH vs MIS";
     };
     auto row = [&](const split_result& res, const model_result& m, const std::string& model) {
         double se = 0.0;
         for (const auto& v : m.views) se = std::max(se, v.se_rel);
         const bool plain = model == "split-sum";
+        std::string cmp;
+        if (!plain)
+            cmp = fmt2("; vs split sum %+.2f%% (noise %.2f%%)", 100.0 * res.excess(), 100.0 * res.noise()) +
+                  (res.worse() ? " WORSE" : "");
         table_row r{name_of(model) + res.material + fmt(" r=%.1f", res.roughness), method_of(model),
                     std::to_string(nviews_) + " views x " + std::to_string(samples_) + " spp", plain ? res.ms : -1.0,
                     fmt2("mean |rel| %.2f%%, max |rel| %.2f%%", 100.0 * m.mean_abs_rel, 100.0 * m.max_abs_rel) +
-                        fmt(" (ref se %.2f%%)", 100.0 * se)};
+                        fmt(" (ref se %.2f%%)", 100.0 * se) + cmp};
         r.detail = true;
         r.alarm(m.max_abs_rel, alarm_relative, model_meaning(model));
         rows.push_back(r);
@@ -181,8 +199,10 @@ std::vector<table_row> split_sum_stage::rows() const {
     auto summary = [&](const std::string& model, bool runtime) {
         for (const material_case& mc : k_materials) {
             double worst = -1.0, at = 0.0, se = 0.0, ms = 0.0;
+            int worse = 0; // roughness values where the runtime model is worse than the split sum beyond noise
             for (const auto& res : results_) {
                 if (res.material != mc.name) continue;
+                if (runtime && res.worse()) ++worse;
                 const model_result& m = runtime ? res.runtime : res.plain;
                 if (m.max_abs_rel > worst) worst = m.max_abs_rel, at = res.roughness;
                 for (const auto& v : m.views) se = std::max(se, v.se_rel);
@@ -192,7 +212,8 @@ std::vector<table_row> split_sum_stage::rows() const {
             table_row r{name_of(model) + mc.name, method_of(model), std::to_string(nviews_) + " views x 3 r", model == "split-sum" ? ms : -1.0,
                         ""};
             r.compact(model == "split-sum" ? "LD+DFG+SH vs MIS" : model == "lobe" ? "lobe LUT+SH vs MIS" : "2 taps+SH vs MIS",
-                      fmt2("max |rel| %.3g%% (r=%.1f)", 100.0 * worst, at) + fmt(", ref se %.2f%%", 100.0 * se))
+                      fmt2("max |rel| %.3g%% (r=%.1f)", 100.0 * worst, at) + fmt(", ref se %.2f%%", 100.0 * se) +
+                          (worse > 0 ? std::string(", WORSE than split sum") : std::string()))
                 .alarm(worst, alarm_relative, model_meaning(model));
             r.summary = true; // the wide table has the rows per roughness instead
             rows.push_back(r);
@@ -215,9 +236,15 @@ void split_sum_stage::report(json_writer& j) const {
                           "LUT), the chain by the bake's lookup, the "
                           "diffuse product; against ibl::reference_radiance (MIS of the BRDF and the source's luminance "
                           "distribution), same diffuse weighting. materials: the runtime model; materials_split_sum: "
-                          "the plain split sum of the same products");
+                          "the plain split sum of the same products; mean_abs_rel_std_error: the standard error of "
+                          "mean_abs_rel from the reference's (sqrt(sum_views ((1 + rel) reference_rel_std_error)^2) / "
+                          "views); vs_split_sum (materials): excess = mean_abs_rel - the split sum's, noise = 2 "
+                          "sqrt(se^2 + se_split_sum^2), worse = excess > noise");
     j.key("runtime_model").value(model_);
     j.key("samples_per_view").value(samples_);
+    std::size_t worse = 0;
+    for (const auto& s : results_) worse += s.worse() ? 1 : 0;
+    j.key("runtime_worse_than_split_sum").value(std::uint64_t(model_ == "split-sum" ? 0 : worse));
     report_model(j, true);
     report_model(j, false);
     j.end_object();
@@ -229,7 +256,14 @@ void split_sum_stage::report_model(json_writer& j, bool runtime) const {
         const model_result& m = runtime ? s.runtime : s.plain;
         j.begin_object();
         j.key("material").value(s.material).key("roughness").value(s.roughness);
-        j.key("mean_abs_rel").value(m.mean_abs_rel).key("max_abs_rel").value(m.max_abs_rel).key("time_ms").value(s.ms);
+        j.key("mean_abs_rel").value(m.mean_abs_rel).key("mean_abs_rel_std_error").value(m.mean_abs_rel_se());
+        j.key("max_abs_rel").value(m.max_abs_rel).key("time_ms").value(s.ms);
+        if (runtime) {
+            j.key("vs_split_sum").begin_object();
+            j.key("split_sum_mean_abs_rel").value(s.plain.mean_abs_rel).key("split_sum_std_error").value(s.plain.mean_abs_rel_se());
+            j.key("excess").value(s.excess()).key("noise").value(s.noise()).key("worse").value(model_ != "split-sum" && s.worse());
+            j.end_object();
+        }
         j.key("views").begin_array();
         for (const auto& v : m.views) {
             j.begin_object();

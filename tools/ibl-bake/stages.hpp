@@ -86,15 +86,24 @@ struct product_view {
     ibl::dfg_lut_layout dfg_layout{};
     const ibl::disk_light<double>* sun = nullptr; ///< an extracted sun, added by the shading functions
     const ibl::lobe_lut* lobe = nullptr;          ///< the lobe LUT: the runtime model is lobe when set
+    /// The lobe model's B-part kernel table (f_B, r_B; ibl::make_lobe_pair_lut): with `lobe` the
+    /// two-part model F0 A LD(d_A, r_A) + F90 B LD(d_B, r_B) (ibl::specular_lobe_pair); without it
+    /// the one-kernel model (ibl::specular_lobe: bakes before the two-part model).
+    const ibl::lobe_lut* lobe_b = nullptr;
     const ibl::lobe_taps_lut* taps = nullptr;     ///< the two-tap table: the runtime model is taps2 when set
     ibl::ld_weight weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight (of the sun's LD term)
 
     /// LD at reflection direction r_dir and roughness (the chain only).
     dvec3 ld(const dvec3& r_dir, double roughness) const;
-    /// The products at a shading point through the runtime model (see above).
-    ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness) const;
+    /// The products at a shading point through the runtime model (see above). The two-part lobe
+    /// model's LD depends on the material's F0, F90: its sample holds the effective LD
+    /// (ibl::lobe_pair_ld) whose LD (F0 A + F90 B) is the model's specular.
+    ibl::ibl_sample<double> sample(const dvec3& n, const dvec3& v, double roughness, const dvec3& f0 = dvec3(1.0),
+                                   const dvec3& f90 = dvec3(1.0)) const;
     /// The lobe LUT's (A, B, s, r_eff) at (n.v, r) (ibl::lobe_lut_lookup); needs `lobe`.
     ibl::vec4<double> lobe_params(double n_dot_v, double roughness) const;
+    /// The B-part table's (f_B, r_B) at (n.v, r) (ibl::lobe_lut_lookup); needs `lobe_b`.
+    ibl::vec2<double> lobe_b_params(double n_dot_v, double roughness) const;
     /// The two-tap table's 8 channels at (n.v, r) (one bilinear read in the DFG layout, as
     /// ibl::specular_lobe_taps reads it); needs `taps`.
     std::array<float, 8> taps_params(double n_dot_v, double roughness) const;
@@ -102,6 +111,7 @@ struct product_view {
     product_view split_sum() const {
         product_view p = *this;
         p.lobe = nullptr;
+        p.lobe_b = nullptr;
         p.taps = nullptr;
         return p;
     }

@@ -13,10 +13,11 @@
 uniform samplerCube u_chain;
 uniform samplerCube u_irradiance;
 uniform sampler2D u_lut;
-uniform sampler2D u_lobe;  // the lobe LUT (A, B, s, r_eff) in the DFG layout (u_runtime 1)
+uniform sampler2D u_lobe;  // the lobe LUT (A, B, s, r_eff) in the DFG layout (u_runtime 1 and 3)
+uniform sampler2D u_lobe_b; // the lobe model's B-part table (f_B, r_B, 0, 0) (u_runtime 3)
 uniform sampler2D u_taps_a; // the two-tap table, channels 0..3 (A, B, angle0, roughness0) (u_runtime 2)
 uniform sampler2D u_taps_b; // channels 4..7 (weight0, angle1, roughness1, weight1)
-uniform int u_runtime;     // 0 split sum (LD(R, r), DFG), 1 the lobe model, 2 taps2 (report.json runtime_model)
+uniform int u_runtime;     // 0 split sum (LD(R, r), DFG), 1 the one-kernel lobe model, 2 taps2, 3 the two-part lobe model (report.json runtime_model)
 uniform vec3 u_sh[9];
 uniform int u_diffuse;     // 0 none, 1 SH, 2 irradiance map
 uniform ivec4 u_spec_levels; // virtual_levels, first_level, stored_levels, mapping
@@ -58,6 +59,7 @@ vec3 shade_sphere(vec3 n, vec3 v, ibl_material mat) {
     ibl_material_terms m = ibl_resolve_material(mat);
     ibl_sample s; // (WebGL forbids ?: on structures)
     if (u_runtime == 2) s = ibl_lobe_taps2_sample(u_chain, spec_desc(), u_taps_a, u_taps_b, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
+    else if (u_runtime == 3) s = ibl_lobe_pair_sample(u_chain, spec_desc(), u_lobe, u_lobe_b, dfg_layout(), n, v, m.roughness, m.f0, m.f90, diffuse_over_pi(n));
     else if (u_runtime == 1) s = ibl_lobe_sample(u_chain, spec_desc(), u_lobe, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     else s = ibl_lookup_sample(u_chain, spec_desc(), u_lut, dfg_layout(), n, v, m.roughness, diffuse_over_pi(n));
     vec3 c = ibl_ambient(m, clamp(dot(n, v), 0.0, 1.0), s, u_spec_rule.z != 0);

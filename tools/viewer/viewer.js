@@ -16,7 +16,9 @@
 // irradiance.ktx2 (texels hold E; used when plan.runtime.diffuse is "irradiance_map"), lights.json
 // (optional: an extracted sun, added back as a disk light; the chain and the diffuse product hold the
 // environment without it), lobe_lut.hpp (when plan.runtime.runtime_model.name is "lobe": the lobe
-// LUT, and the spheres are shaded by the lobe model, ibl_lobe_sample), lobe_taps.hpp (when it is
+// LUT, and the spheres are shaded by the lobe model: with runtime_model.parts = 2 also
+// lobe_lut_b.hpp, the B part's kernel table, and the two-part model ibl_lobe_pair_sample; a bake
+// without parts: the one-kernel ibl_lobe_sample), lobe_taps.hpp (when it is
 // "taps2": the two-tap table, uploaded as the two RGBA textures of ibl_common.glsl's storage split,
 // and the spheres are shaded by the two-tap model, ibl_lobe_taps2_sample); else by the split
 // sum.
@@ -97,6 +99,8 @@ async function loadBake(src) {
     bake.dfg = parseDfgHeader(await src.text('dfg.hpp'));
     bake.model = runtimeModelOf(bake.report);
     bake.lobe = bake.model === 'lobe' ? parseDfgHeader(await src.text('lobe_lut.hpp'), 'lobe_lut') : null;
+    const parts = bake.report && bake.report.plan.runtime.runtime_model.parts;
+    bake.lobeB = bake.model === 'lobe' && parts === 2 ? parseDfgHeader(await src.text('lobe_lut_b.hpp'), 'lobe_lut_b') : null;
     bake.taps = bake.model === 'taps2' ? parseDfgHeader(await src.text('lobe_taps.hpp'), 'lobe_taps') : null;
     if (bake.taps && bake.taps.channels !== 8) throw new Error(`lobe_taps.hpp: ${bake.taps.channels} channels, expected 8 (two taps)`);
     bake.chain = parseKtx2Cubemap(await src.bytes('specular.ktx2'), 'specular.ktx2');
@@ -258,6 +262,8 @@ class Renderer {
         const lobe = bake.lobe ? uploadLut(gl, bake.lobe, null) : null; // (A, B, s, r_eff): four channels as stored
         this.lobeTex = lobe ? lobe.tex : this.lutTex;
         this.lobeFormat = lobe ? lobe.format : null;
+        const lobeB = bake.lobeB ? uploadLut(gl, bake.lobeB, null) : null; // (f_B, r_B, 0, 0)
+        this.lobeBTex = lobeB ? lobeB.tex : this.lutTex;
         // the two-tap table: taps_a = channels 0..3, taps_b = channels 4..7 (ibl_common.glsl)
         const tapsA = bake.taps ? uploadLut(gl, tapsHalf(bake.taps, 0), null) : null;
         const tapsB = bake.taps ? uploadLut(gl, tapsHalf(bake.taps, 4), null) : null;
@@ -304,7 +310,10 @@ class Renderer {
         gl.activeTexture(gl.TEXTURE5);
         gl.bindTexture(gl.TEXTURE_2D, this.tapsBTex);
         gl.uniform1i(u('u_taps_b'), 5);
-        gl.uniform1i(u('u_runtime'), this.bake.model === 'lobe' ? 1 : this.bake.model === 'taps2' ? 2 : 0);
+        gl.activeTexture(gl.TEXTURE6);
+        gl.bindTexture(gl.TEXTURE_2D, this.lobeBTex);
+        gl.uniform1i(u('u_lobe_b'), 6);
+        gl.uniform1i(u('u_runtime'), this.bake.model === 'lobe' ? (this.bake.lobeB ? 3 : 1) : this.bake.model === 'taps2' ? 2 : 0);
         gl.uniform3fv(u('u_sh[0]'), this.sh);
         gl.uniform1i(u('u_diffuse'), rt.diffuse === 'sh' ? 1 : rt.diffuse === 'irradiance_map' && this.bake.irradiance ? 2 : 0);
         const spec = view.lookup === 'textbook' ? { weight: 'lod', interpolation: 'linear' }
@@ -378,6 +387,7 @@ class Renderer {
             runtime_model: this.bake.model,
             lobe_texture: this.lobeFormat,
             lobe_size: this.bake.lobe ? this.bake.lobe.size : 0,
+            lobe_parts: this.bake.lobeB ? 2 : this.bake.lobe ? 1 : 0,
             taps_texture: this.tapsFormat,
             taps_size: this.bake.taps ? this.bake.taps.size : 0,
             lut_size: this.bake.dfg.size,

@@ -37,7 +37,13 @@
 //           RGBA table in the DFG table's layout and orientation (row 0 = the smallest
 //           roughness), R = A, G = B, B = s (the lerp factor of the lookup direction
 //           normalize(lerp(n, R, s))), A = r_eff (the chain roughness to read there); specular =
-//           LD(d, r_eff) (F0 A + F90 B). Clamp to edge, bilinear (RGBA32F: lobe_lut.hpp's floats).
+//           LD(d, r_eff) (F0 A + F90 B) with this table alone (one kernel); ibl-bake's lobe
+//           model reads it with the B-part table below (two parts).
+// Lobe LUT B  the lobe model's second table (lobe_lut_b.exr / lobe_lut_b.hpp, same size, layout
+//           and orientation): R = f_B (the Fresnel B part's kernel angle from n towards R over
+//           acos(n.v)), G = r_B, B = A = 0; specular = F0 A LD(normalize(lerp(n, R, s)), r_eff) +
+//           F90 B LD(cos(a) n + sin(a) t, r_B), a = min(f_B acos(n.v), pi/2), t the tangent of n
+//           towards R (ibl_runtime.glsl ibl_specular_lobe_pair). Clamp to edge, bilinear (RGBA32F).
 // Taps LUT  the two-tap fitted model of ibl/runtime.hpp (specular_lobe_taps; lobe_fit.hpp's
 //           make_lobe_taps_lut with taps = 2): its eight channels per texel, in the DFG table's
 //           layout and orientation, as two RGBA textures of the same size: taps_a = channels

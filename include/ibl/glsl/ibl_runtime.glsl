@@ -5,7 +5,7 @@
 // ibl_common.glsl) read about n or about a bent normal; runtime filtered importance sampling of
 // the chain (K taps along the GGX visible-normal lobe, each read at its footprint's roughness);
 // the fitted-taps model of integrate/lobe_fit.hpp in its two-tap form (two RGBA tables,
-// ibl_common.glsl). The formulas and their derivations are in runtime.hpp's and occlusion.hpp's
+// ibl_common.glsl); the two-part lobe model (the lobe LUT plus the B part's kernel table). The formulas and their derivations are in runtime.hpp's and occlusion.hpp's
 // headers; every function here is the same expression in the same order. Needs
 // ibl_common.glsl, ibl_lookup.glsl and ibl_shade.glsl first.
 //
@@ -333,6 +333,54 @@ vec3 ibl_specular_lobe_taps2(samplerCube chain, ibl_specular_desc sd, sampler2D 
                              ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90) {
     ibl_sample s = ibl_lobe_taps2_sample(chain, sd, taps_a, taps_b, lay, n, v, roughness, vec3(0.0));
     return ibl_specular_ibl(s.ld, f0, f90, s.dfg);
+}
+
+// ---- the two-part lobe model (runtime.hpp specular_lobe_pair; ibl-bake --runtime lobe) ---------
+
+// The effective LD (F0 A LD_a + F90 B LD_b) / (F0 A + F90 B) per channel (LD_a where that albedo
+// is 0): LD (F0 A + F90 B) of it, e.g. ibl_ambient, is the two-part model (lobe_pair_ld).
+vec3 ibl_lobe_pair_ld(vec3 ld_a, vec3 ld_b, vec3 f0, vec3 f90, vec2 ab) {
+    vec3 wa = f0 * ab.x, wb = f90 * ab.y, den = wa + wb;
+    vec3 mixed = (wa * ld_a + wb * ld_b) / max(den, vec3(1e-30));
+    return vec3(den.x > 0.0 ? mixed.x : ld_a.x, den.y > 0.0 ? mixed.y : ld_a.y, den.z > 0.0 ? mixed.z : ld_a.z);
+}
+
+// The B kernel's direction: at a = clamp(f_B acos(n.v), 0, pi/2) from n towards R,
+// cos(a) n + sin(a) t, t = ibl_incidence_tangent(n, R) (lobe_pair_direction_b).
+vec3 ibl_lobe_pair_direction_b(vec3 n, vec3 r_dir, float stored, float n_dot_v) {
+    float a = clamp(ibl_lobe_tap_angle(stored, n_dot_v), 0.0, 1.5707963267948966);
+    vec3 d = cos(a) * n + sin(a) * ibl_incidence_tangent(n, r_dir);
+    return d * (1.0 / sqrt(dot(d, d)));
+}
+
+// The products at a shading point through the two-part lobe model for a material (F0, F90): at
+// (n.v, r) (A, B, s, r_eff) = ibl_lobe_lut_lookup(lobe_lut) and (f_B, r_B) = ibl_lobe_lut_lookup(
+// lobe_lut_b) (lobe_lut.hpp, lobe_lut_b.hpp), LD_a at ibl_lobe_direction(n, v, s) and r_eff, LD_b at
+// ibl_lobe_pair_direction_b and r_B; the sample's ld is ibl_lobe_pair_ld of them, its dfg (A, B);
+// E/pi passed through. ibl_ambient on it (with the same F0, F90) is the two-part model:
+// F0 A LD_a + F90 B LD_b. Cost: two chain lookups and two RGBA table reads.
+ibl_sample ibl_lobe_pair_sample(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, sampler2D lobe_lut_b,
+                                ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90,
+                                vec3 irradiance_over_pi) {
+    float n_dot_v = ibl_saturate(dot(n, v));
+    vec3 r_dir = 2.0 * dot(n, v) * n - v;
+    vec4 pa = ibl_lobe_lut_lookup(lobe_lut, n_dot_v, roughness, lay);
+    vec4 pb = ibl_lobe_lut_lookup(lobe_lut_b, n_dot_v, roughness, lay);
+    vec3 ld_a = ibl_specular_lookup(chain, ibl_lerp_direction(n, r_dir, pa.z), pa.w, sd);
+    vec3 ld_b = ibl_specular_lookup(chain, ibl_lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+    return ibl_sample(ibl_lobe_pair_ld(ld_a, ld_b, f0, f90, pa.xy), irradiance_over_pi, pa.xy);
+}
+
+// The two-part model's specular F0 A LD(d_A, r_eff) + F90 B LD(d_B, r_B) (specular_lobe_pair).
+vec3 ibl_specular_lobe_pair(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, sampler2D lobe_lut_b,
+                            ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90) {
+    float n_dot_v = ibl_saturate(dot(n, v));
+    vec3 r_dir = 2.0 * dot(n, v) * n - v;
+    vec4 pa = ibl_lobe_lut_lookup(lobe_lut, n_dot_v, roughness, lay);
+    vec4 pb = ibl_lobe_lut_lookup(lobe_lut_b, n_dot_v, roughness, lay);
+    vec3 ld_a = ibl_specular_lookup(chain, ibl_lerp_direction(n, r_dir, pa.z), pa.w, sd);
+    vec3 ld_b = ibl_specular_lookup(chain, ibl_lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+    return f0 * pa.x * ld_a + f90 * pa.y * ld_b;
 }
 
 #endif // IBL_GLSL_RUNTIME

@@ -117,6 +117,16 @@ struct lobe_mixture {
     double l1_moments = 2.0;
 };
 
+/// The part of the specular lobe a fit describes (lobe_fit_options::part).
+enum class lobe_fresnel_part { whole, a, b };
+
+/// The Schlick weight of a part at v.h: 1, 1 - (1 - v.h)^5 or (1 - v.h)^5 (header).
+inline double lobe_fresnel_part_weight(lobe_fresnel_part part, double v_dot_h) noexcept {
+    if (part == lobe_fresnel_part::whole) return 1.0;
+    const double f = std::pow(1.0 - saturate(v_dot_h), 5.0);
+    return part == lobe_fresnel_part::b ? f : 1.0 - f;
+}
+
 /// What the fit may use: `taps` kernels (1..lobe_max_taps); level_roughness empty: kernels of any
 /// roughness (a tap's roughness is r', read by any lookup that approximates K(r')); otherwise the
 /// chain's stored levels (level l prefiltered at level_roughness[l], ascending, level 0 may be the
@@ -139,6 +149,11 @@ struct lobe_fit_options {
     /// identical copy of the heaviest tap. Tables then stay continuous where an extra tap has no
     /// use (at n.v = 1 one kernel of a G1 chain is exact, and any split of it fits as well).
     double min_gain = 5e-3;
+    /// Which part of the Schlick-weighted lobe is fitted: whole (F = 1: the lobe of A + B), the A
+    /// part (weight 1 - (1 - v.h)^5: the lobe that F0 multiplies) or the B part (weight
+    /// (1 - v.h)^5: the lobe that F90 multiplies, dominant for a dielectric). The two parts have
+    /// different shapes and directions: the B part leans further towards grazing reflection.
+    lobe_fresnel_part part = lobe_fresnel_part::whole;
 };
 
 namespace detail {
@@ -151,17 +166,21 @@ struct lobe_points {
     double weight_sum = 0.0;
 };
 
-template <class Model> lobe_points make_lobe_points(double mu, double roughness, std::uint32_t nodes) {
+template <class Model>
+lobe_points make_lobe_points(double mu, double roughness, std::uint32_t nodes, lobe_fresnel_part part = lobe_fresnel_part::whole) {
     lobe_points out;
     const double alpha = clamp_alpha(Model::alpha(roughness));
     const double g1_over_nv = ggx_g1_over_n_dot_v(mu, alpha);
     const std::uint32_t q = std::max<std::uint32_t>(nodes, 1);
+    const vec3<double> v(std::sqrt((1.0 - mu) * (1.0 + mu)), 0.0, mu);
     double e = 0.0;
     for_each_lobe_draw<Model>(mu, roughness, q, [&](const vec3<double>& l, const vec3<double>& h, double vis) {
-        const double w = 4.0 * vis * l.z / g1_over_nv;
+        const double f = lobe_fresnel_part_weight(part, glm::dot(v, h));
+        const double w = 4.0 * vis * l.z / g1_over_nv * f;
+        if (!(w > 0.0)) return;
         out.l.push_back(l);
         out.weight.push_back(w);
-        out.p.push_back(Model::ndf(h.z, alpha) * vis * l.z); // / E below
+        out.p.push_back(Model::ndf(h.z, alpha) * vis * l.z * f); // / E below
         e += w;
     });
     out.weight_sum = e;
@@ -324,7 +343,7 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     // the start (and the moment match reported beside the fit): coarse quadratures suffice
     const lobe_moments m = specular_lobe_moments<Model>(mu, r, 32);
     const double r_eff = std::max(ld_matched_roughness(m.rho, w, 256), 0.01);
-    const detail::lobe_points pts = detail::make_lobe_points<Model>(mu, r, o.nodes);
+    const detail::lobe_points pts = detail::make_lobe_points<Model>(mu, r, o.nodes, o.part);
     const bool lv = !o.level_roughness.empty();
     const double vmax = lv ? double(o.level_roughness.size() - 1) : 1.0;
     auto to_value = [&](double rr) { // roughness -> the tap's parameter (lod for stored levels)
@@ -381,7 +400,11 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     }
     out.count = n_taps;
     detail::taps_from_params(x.data(), n_taps, vmax, out.taps);
-    std::sort(out.taps.begin(), out.taps.begin() + n_taps, [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
+    { // sorted through a vector: g++ 12 -O3 reads std::sort over a prefix of the array as out of bounds
+        std::vector<lobe_tap> sorted(out.taps.begin(), out.taps.begin() + n_taps);
+        std::sort(sorted.begin(), sorted.end(), [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
+        std::copy(sorted.begin(), sorted.end(), out.taps.begin());
+    }
     out.l1 = o.leak_weight > 0.0 ? detail::mixture_l1(pts, out.taps, n_taps, w, o.level_roughness) : best;
     return out;
 }
@@ -459,19 +482,15 @@ lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layou
     return lut;
 }
 
-/// The one-tap fit as a lobe LUT (A, B, s, r_eff) for ibl::specular_lobe (runtime.hpp): s the
-/// lerp factor whose normalize(lerp(n, R, s)) is at the fitted angle (clamped to [0, 1]: between
-/// n and R). Same layout and argument rules as make_lobe_taps_lut (o.taps is ignored: 1;
-/// level_roughness must be empty).
-template <class Model = ggx_height_correlated, class Executor = thread_executor>
-lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, lobe_fit_options o = {},
-                              Executor&& ex = Executor{}) {
-    o.taps = 1;
-    o.level_roughness.clear();
-    const lobe_taps_lut t = make_lobe_taps_lut<Model>(size, layout, w, o, ex);
+namespace detail {
+/// A one-tap lobe_taps_lut as a lobe LUT (A, B, s, r_eff): s the lerp factor whose
+/// normalize(lerp(n, R, s)) is at the tap's angle (clamped to [0, 1]: between n and R).
+inline lobe_lut lobe_lut_from_one_tap(const lobe_taps_lut& t) {
+    const std::uint32_t size = t.size;
+    const dfg_lut_layout& layout = t.layout;
     lobe_lut lut;
     lut.size = size;
-    lut.weight = w;
+    lut.weight = t.weight;
     lut.layout = layout;
     lut.data.assign(std::size_t(size) * size * 4, 0.0f);
     for (std::uint32_t j = 0; j < size; ++j)
@@ -487,6 +506,58 @@ lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, 
             dst[3] = src[3];
         }
     return lut;
+}
+} // namespace detail
+
+/// The one-tap fit as a lobe LUT (A, B, s, r_eff) for ibl::specular_lobe (runtime.hpp): s the
+/// lerp factor whose normalize(lerp(n, R, s)) is at the fitted angle (clamped to [0, 1]: between
+/// n and R). Same layout and argument rules as make_lobe_taps_lut (o.taps is ignored: 1;
+/// level_roughness must be empty).
+template <class Model = ggx_height_correlated, class Executor = thread_executor>
+lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, lobe_fit_options o = {},
+                              Executor&& ex = Executor{}) {
+    o.taps = 1;
+    o.level_roughness.clear();
+    return detail::lobe_lut_from_one_tap(make_lobe_taps_lut<Model>(size, layout, w, o, ex));
+}
+
+/// The two-part lobe model's tables (ibl::specular_lobe_pair, runtime.hpp). The specular lobe
+/// with Schlick's Fresnel is F0 times its A part (weight 1 - (1 - v.h)^5) plus F90 times its B
+/// part (weight (1 - v.h)^5). The B part has another shape and direction (it leans beyond R
+/// towards grazing reflection: at n.v = 0.9, r = 0.5 its fitted kernel sits 2.7 view angles from
+/// n, and the whole lobe's kernel is at L1 distance 1.5 of it, 2 being disjoint), and a
+/// dielectric's specular is mostly B; the A part is the whole lobe but for a small grazing
+/// share (the whole lobe's kernel is within 0.013 in L1 of the A part's own fit).
+///   a: (A, B, s, r_eff)  make_lobe_lut_fitted's table (the whole lobe's kernel, read for the A
+///                        part; the same file a one-kernel consumer reads);
+///   b: (f_B, r_B, 0, 0)  the B part's kernel (o.part = b): its angle from n towards R over the
+///                        view angle acos(n.v) (as the fitted taps' angles: runtime.hpp
+///                        lobe_tap_angle; the B kernel may lie beyond R, which no lerp factor in
+///                        [0, 1] reaches) and its chain roughness. The mirror row: at R, 0.
+/// Both in the same DFG layout and size; o.taps is ignored (1), o.part is set per table.
+struct lobe_pair_lut {
+    lobe_lut a, b;
+};
+
+template <class Model = ggx_height_correlated, class Executor = thread_executor>
+lobe_pair_lut make_lobe_pair_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, lobe_fit_options o = {},
+                                 Executor&& ex = Executor{}) {
+    o.taps = 1;
+    o.level_roughness.clear();
+    lobe_pair_lut out;
+    o.part = lobe_fresnel_part::whole;
+    out.a = detail::lobe_lut_from_one_tap(make_lobe_taps_lut<Model>(size, layout, w, o, ex));
+    o.part = lobe_fresnel_part::b;
+    const lobe_taps_lut tb = make_lobe_taps_lut<Model>(size, layout, w, o, ex);
+    out.b.size = size;
+    out.b.weight = w;
+    out.b.layout = layout;
+    out.b.data.assign(std::size_t(size) * size * 4, 0.0f);
+    for (std::size_t k = 0; k < std::size_t(size) * size; ++k) {
+        out.b.data[k * 4] = tb.data[k * tb.channels + 2];
+        out.b.data[k * 4 + 1] = tb.data[k * tb.channels + 3];
+    }
+    return out;
 }
 
 } // namespace ibl

@@ -1,10 +1,10 @@
 // tools/ibl-bake/tests/test_lookup_mode.cpp — `ibl-bake --lookup DIR` answers as the library's
 // runtime functions do on the files of DIR. A tiny bake is made; the test loads its files itself
 // (specular.ktx2 decoded to an ibl::cubemap, dfg.exr to an ibl::dfg_lut, sh.json's shader
-// coefficients, lobe_lut.exr, lobe_taps_a.exr + lobe_taps_b.exr) and evaluates
+// coefficients, lobe_lut.exr + lobe_lut_b.exr, lobe_taps_a.exr + lobe_taps_b.exr) and evaluates
 // ibl::specular_lookup, ibl::dfg_lookup, ibl::sh_shader_evaluate, ibl::lobe_lut_lookup, the
 // two-tap table's bilinear read and pbr_shader::ambient (multiple scattering) on the bake's
-// runtime model (the default: ibl::specular_lobe; taps2: ibl::specular_lobe_taps; split-sum:
+// runtime model (the accurate preset's lobe model: ibl::specular_lobe_pair's effective LD, ibl::lobe_pair_ld; taps2: ibl::specular_lobe_taps; split-sum:
 // LD(R, r) DFG) at the
 // same queries; every answer must agree to float precision (relative 2e-6, about 16 float ulps:
 // the answers are printed with 9 digits). Malformed queries get an error line each and exit
@@ -85,12 +85,20 @@ ibl::lobe_lut load_lobe(const std::string& path) {
     return lut;
 }
 
-/// LD of the lobe model at (n, v, r): ibl::specular_lobe with F0 = F90 = 1 gives LD (A + B).
-dvec3 lobe_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const dvec3& n, const dvec3& v, double r) {
-    const fvec3 fn(n), fv(v);
-    const ibl::vec4<float> p = ibl::lobe_lut_lookup(lobe, ibl::saturate(glm::dot(fn, fv)), float(r));
-    const fvec3 e = ibl::specular_lobe(chain, ibl::specular_lookup_desc::accurate(), lobe, fn, fv, float(r), fvec3(1.0f), fvec3(1.0f));
-    return dvec3(e) / double(ibl::saturate(p.x) + ibl::saturate(p.y));
+/// The effective LD of the two-part lobe model (ibl::lobe_pair_ld) for a material, formed as the
+/// tool forms it: R in double, the directions in float, each chain read by the accurate lookup.
+dvec3 lobe_pair_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const ibl::lobe_lut& lobe_b, const dvec3& n,
+                   const dvec3& v, double r, const dvec3& f0, const dvec3& f90) {
+    const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
+    const double ndv = std::clamp(glm::dot(n, v), 0.0, 1.0);
+    const dvec3 r_dir = 2.0 * glm::dot(n, v) * n - v;
+    const ibl::vec4<float> pa = ibl::lobe_lut_lookup(lobe, float(ndv), float(r));
+    const ibl::vec4<float> pb = ibl::lobe_lut_lookup(lobe_b, float(ndv), float(r));
+    const fvec3 d_a = ibl::lerp_direction(fvec3(n), fvec3(r_dir), pa.z);
+    const fvec3 d_b = ibl::lobe_pair_direction_b(fvec3(n), fvec3(r_dir), pb.x, float(ndv));
+    const dvec3 ld_a(ibl::specular_lookup(chain, fvec3(dvec3(d_a)), pa.w, sd));
+    const dvec3 ld_b(ibl::specular_lookup(chain, fvec3(dvec3(d_b)), pb.y, sd));
+    return ibl::lobe_pair_ld(ld_a, ld_b, f0, f90, ibl::vec2<double>(pa.x, pa.y));
 }
 
 /// The two-tap table from its two RGBA files (channels 0..3 and 4..7).
@@ -175,7 +183,8 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
     const ibl::cubemap<float> chain = load_chain(s / "bake/specular.ktx2");
     const ibl::dfg_lut lut = load_lut(s / "bake/dfg.exr");
     const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
-    const ibl::lobe_lut lobe = load_lobe(s / "bake/lobe_lut.exr"); // the default runtime model
+    const ibl::lobe_lut lobe = load_lobe(s / "bake/lobe_lut.exr"); // the accurate preset's runtime model
+    const ibl::lobe_lut lobe_b = load_lobe(s / "bake/lobe_lut_b.exr"); // its B part
     const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
 
     std::vector<std::string> q;
@@ -209,15 +218,20 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
         ibl::ibl_sample<double> smp;
         const double ndv = std::clamp(glm::dot(d, v), 0.0, 1.0);
         const ibl::vec4<float> pv = ibl::lobe_lut_lookup(lobe, float(ndv), float(r));
-        smp.ld = lobe_ld(chain, lobe, d, v, r);
+        const auto shader = ibl::pbr_shader<double>::from(m, true);
+        smp.ld = lobe_pair_ld(chain, lobe, lobe_b, d, v, r, shader.m.f0, shader.m.f90);
         smp.dfg = ibl::vec2<double>(pv.x, pv.y);
         smp.irradiance_over_pi = glm::max(ibl::sh_shader_evaluate(shc, d), dvec3(0.0));
-        const dvec3 lo = ibl::pbr_shader<double>::from(m, true).ambient(ndv, smp);
+        const dvec3 lo = shader.ambient(ndv, smp);
         want.push_back({lo.x, lo.y, lo.z});
         std::snprintf(buf, sizeof buf, "lobe %.17g %.17g", nv, r);
         q.push_back(buf);
         const ibl::vec4<float> pl = ibl::lobe_lut_lookup(lobe, float(nv), float(r));
         want.push_back({pl.x, pl.y, pl.z, pl.w});
+        std::snprintf(buf, sizeof buf, "lobe_b %.17g %.17g", nv, r);
+        q.push_back(buf);
+        const ibl::vec4<float> pbl = ibl::lobe_lut_lookup(lobe_b, float(nv), float(r));
+        want.push_back({pbl.x, pbl.y});
     }
     std::ofstream(s / "queries.txt") << "# a comment\n\n" << [&] {
         std::string all;
