@@ -77,7 +77,7 @@ def masked(text):
         elif ms_end is not None and len(line) >= ms_end and (len(line) == ms_end or line[ms_end] == " "):
             m = re.search(r"\d+\.\d+$", line[:ms_end])
             if m:
-                line = line[: m.start()] + "T" * len(m.group(0)) + line[ms_end:]
+                line = line[: m.start()] + "T" + line[ms_end:]
         line = re.sub(r"\d+(?:\.\d+)?( ms)", r"T\1", line)
         line = re.sub(r"\d+(?:\.\d+)?% of the", "T% of the", line)
         line = re.sub(r"\b(source|specular|diffuse|dfg|lobe lut) \d+(?:\.\d+)?", r"\1 T", line)
