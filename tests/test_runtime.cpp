@@ -205,3 +205,36 @@ TEST_CASE("prefilter: the G1 weight replaces n.l in the LD table and keeps a con
     for (int l = 0; l < out.levels(); ++l)
         CHECK(double(out.texel(2, 0, 0, l).y) == doctest::Approx(3.0).epsilon(16 * feps));
 }
+
+TEST_CASE("specular_chain: prefilter records its weight and mapping; lookups read the mapping and refuse a lobe table of another weight") {
+    ibl::cubemap<float> src(16, 1);
+    src.fill(0, [](int f, int x, int) { return f3(1.0f + float(f) + 0.1f * float(x)); });
+    src.update_borders();
+    src.generate_mips();
+    ibl::prefilter_options o;
+    o.samples = 32;
+    o.policy = ibl::roughness_mip_policy::filament();
+    const ibl::specular_chain chain = ibl::prefilter(src, o);
+    CHECK(chain.weight == ibl::ld_weight::n_dot_l);
+    CHECK(chain.mapping == ibl::roughness_mapping::filament);
+    // The default description names the linear mapping; the chain's own (filament) is used, as a
+    // plain cubemap read with the filament description gives.
+    const ibl::cubemap<float>& plain = chain;
+    const f3 dir = glm::normalize(f3(0.3f, 0.5f, -0.8f));
+    for (float r : {0.1f, 0.35f, 0.6f, 0.9f}) {
+        const f3 a = ibl::specular_lookup(chain, dir, r);
+        const f3 b = ibl::specular_lookup(plain, dir, r, ibl::specular_lookup_desc::textbook(ibl::roughness_mapping::filament));
+        const f3 c = ibl::specular_lookup(plain, dir, r); // the caller's (linear) description, as given
+        CHECK(a == b);
+        if (r == 0.35f) CHECK(a != c);
+    }
+    // A lobe table fitted to the G1 weight read over this n.l chain is refused, naming both.
+    const ibl::lobe_lut g1 = ibl::make_lobe_lut<model>(4, ibl::dfg_lut_layout::uniform(), ibl::ld_weight::g1, 16);
+    const f3 n(0.0f, 1.0f, 0.0f), v = glm::normalize(f3(0.0f, 1.0f, 0.5f));
+    CHECK_THROWS_WITH_AS((void)ibl::specular_lobe(chain, {}, g1, n, v, 0.5f, f3(1.0f), f3(1.0f)),
+                         "ibl::specular_lobe: the lobe table was fitted to the G1 chain weight, the chain is n.l-weighted",
+                         std::invalid_argument);
+    CHECK_NOTHROW((void)ibl::specular_lobe(plain, {}, g1, n, v, 0.5f, f3(1.0f), f3(1.0f))); // a plain cubemap: unknown
+    const ibl::lobe_lut nl = ibl::make_lobe_lut<model>(4, ibl::dfg_lut_layout::uniform(), ibl::ld_weight::n_dot_l, 16);
+    CHECK_NOTHROW((void)ibl::specular_lobe(chain, {}, nl, n, v, 0.5f, f3(1.0f), f3(1.0f)));
+}

@@ -55,7 +55,10 @@
 #if IBL_DETAIL_CXX20
 
 #include <cmath>
+#include <concepts>
 #include <cstdint>
+#include <stdexcept>
+#include <string>
 
 #include "core/math.hpp"
 #include "core/vec.hpp"
@@ -204,12 +207,35 @@ IBL_FUNC vec3<T> specular_blend(const specular_taps<T>& s, const vec3<T>* values
     return {v.x > T(0) ? v.x : T(0), v.y > T(0) ? v.y : T(0), v.z > T(0) ? v.z : T(0)};
 }
 
+namespace detail {
+/// The description a chain is read with: d, with the chain's own mapping when the chain records
+/// one (integrate/chain.hpp's specular_chain).
+template <class Chain> specular_lookup_desc chain_desc(const Chain& chain, specular_lookup_desc d) noexcept {
+    if constexpr (requires { chain.mapping; }) d.mapping = chain.mapping;
+    return d;
+}
+/// A lobe table fitted to another LD weight than the chain's is refused (std::invalid_argument),
+/// when both record theirs.
+template <class Chain, class Table> void check_chain_weight(const char* fn, const Chain& chain, const Table& t) {
+    if constexpr (requires { chain.weight == t.weight; })
+        if (!(chain.weight == t.weight))
+            throw std::invalid_argument(std::string("ibl::") + fn + ": the lobe table was fitted to the " +
+                                        (int(t.weight) == 0 ? "n.l" : "G1") + " chain weight, the chain is " +
+                                        (int(chain.weight) == 0 ? "n.l" : "G1") + "-weighted");
+}
+} // namespace detail
+
 /// The specular chain at unit direction dir (the reflection direction R) and roughness r: the taps
 /// of specular_lookup_taps, each a seamless bilinear read of its level, summed; negative channels
 /// (Catmull-Rom) clamped to 0. A two-level lookup is computed as lerp(L_l, L_{l+1}, t), i.e.
-/// exactly the trilinear chain.radiance(dir, l + t) a GPU's textureLod gives.
-inline vec3<float> specular_lookup(const cubemap<float>& chain, const vec3<float>& dir, float roughness,
-                                   const specular_lookup_desc& d = {}) {
+/// exactly the trilinear chain.radiance(dir, l + t) a GPU's textureLod gives. A specular_chain
+/// (what prefilter returns, integrate/chain.hpp) is read with its own mapping (d.mapping is
+/// replaced by the chain's); a plain cubemap with d as given.
+template <class Chain>
+    requires std::derived_from<Chain, cubemap<float>>
+vec3<float> specular_lookup(const Chain& chain_in, const vec3<float>& dir, float roughness, const specular_lookup_desc& d_in = {}) {
+    const cubemap<float>& chain = chain_in;
+    const specular_lookup_desc d = detail::chain_desc(chain_in, d_in);
     const specular_taps<float> s = specular_lookup_taps(roughness, chain.levels(), d);
     vec3<float> v[4];
     for (int k = 0; k < s.count; ++k)
@@ -229,8 +255,9 @@ template <class Table> vec3<float> dfg_lookup(const Table& lut, float n_dot_v, f
 /// The baked products at one shading point, looked up as a renderer does: LD from the chain at
 /// R = reflect(-v, n) and the material's roughness, (A, B) from the table at (n.v, r). n, v unit.
 /// irradiance_over_pi is passed through (E(n)/pi from SH or an irradiance map; 0 if not baked).
-template <class Table>
-ibl_sample<float> ibl_lookup_sample(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
+template <class Chain, class Table>
+    requires std::derived_from<Chain, cubemap<float>>
+ibl_sample<float> ibl_lookup_sample(const Chain& chain, const specular_lookup_desc& sd, const Table& lut,
                                     const vec3<float>& n, const vec3<float>& v, float roughness,
                                     const vec3<float>& irradiance_over_pi = vec3<float>(0.0f)) {
     const float n_dot_v = saturate(glm::dot(n, v));

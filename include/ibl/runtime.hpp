@@ -59,6 +59,7 @@
 #if IBL_DETAIL_CXX20
 
 #include <cmath>
+#include <concepts>
 #include <cstdint>
 
 #include "brdf/fresnel.hpp"
@@ -193,7 +194,9 @@ IBL_FUNC vec3<T> fis_combine(const vec3<T>& weighted_sum, const vec3<T>& weight_
 
 /// Specular radiance by runtime filtered importance sampling of the chain (header): n, v unit,
 /// dfg = (A, B) at (n.v, r) (used by the normalised estimator only).
-inline vec3<float> specular_fis(const cubemap<float>& chain, const runtime_fis_desc& d, const vec3<float>& n,
+template <class Chain>
+    requires std::derived_from<Chain, cubemap<float>>
+vec3<float> specular_fis(const Chain& chain, const runtime_fis_desc& d, const vec3<float>& n,
                                 const vec3<float>& v, float roughness, const vec3<float>& f0, const vec3<float>& f90,
                                 const vec2<float>& dfg) {
     const frame<float> fr = make_frame(n);
@@ -230,10 +233,12 @@ template <class Table> vec4<float> lobe_lut_lookup(const Table& lut, float n_dot
 
 /// The one-tap lobe model (header): LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B) with
 /// (A, B, s, r_eff) = lobe_lut_lookup(lut, n.v, r). sd: the chain's lookup.
-template <class Table>
-vec3<float> specular_lobe(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
+template <class Chain, class Table>
+    requires std::derived_from<Chain, cubemap<float>>
+vec3<float> specular_lobe(const Chain& chain, const specular_lookup_desc& sd, const Table& lut,
                           const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
                           const vec3<float>& f90) {
+    detail::check_chain_weight("specular_lobe", chain, lut);
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
     const vec4<float> p = lobe_lut_lookup(lut, n_dot_v, roughness);
@@ -267,10 +272,12 @@ template <class T> IBL_FUNC T lobe_tap_angle(T stored, T n_dot_v) noexcept {
 ///     Lo_s ~ (F0 A + F90 B) sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k)
 /// with t = incidence_tangent(n, R) and each LD by the chain lookup sd. Cost: taps chain lookups
 /// and ceil((2 + 3 taps) / 4) RGBA table reads.
-template <class Table>
-vec3<float> specular_lobe_taps(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& lut,
+template <class Chain, class Table>
+    requires std::derived_from<Chain, cubemap<float>>
+vec3<float> specular_lobe_taps(const Chain& chain, const specular_lookup_desc& sd, const Table& lut,
                                const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
                                const vec3<float>& f90) {
+    detail::check_chain_weight("specular_lobe_taps", chain, lut);
     constexpr std::uint32_t max_channels = 2 + 3 * 8;
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
@@ -325,10 +332,13 @@ template <class T> IBL_FUNC vec3<T> lobe_pair_direction_b(const vec3<T>& n, cons
 /// (f_B, r_B) = lobe_lut_lookup(b, n.v, r) (integrate/lobe_fit.hpp make_lobe_pair_lut)
 ///     Lo_s ~ F0 A LD(normalize(lerp(n, R, s_A)), r_A) + F90 B LD(d_B, r_B)
 /// d_B = lobe_pair_direction_b(n, R, f_B, n.v). Cost: two chain lookups and two RGBA table taps.
-template <class Table>
-vec3<float> specular_lobe_pair(const cubemap<float>& chain, const specular_lookup_desc& sd, const Table& a, const Table& b,
+template <class Chain, class Table>
+    requires std::derived_from<Chain, cubemap<float>>
+vec3<float> specular_lobe_pair(const Chain& chain, const specular_lookup_desc& sd, const Table& a, const Table& b,
                                const vec3<float>& n, const vec3<float>& v, float roughness, const vec3<float>& f0,
                                const vec3<float>& f90) {
+    detail::check_chain_weight("specular_lobe_pair", chain, a);
+    detail::check_chain_weight("specular_lobe_pair", chain, b);
     const float n_dot_v = saturate(glm::dot(n, v));
     const vec3<float> r_dir = 2.0f * glm::dot(n, v) * n - v;
     const vec4<float> pa = lobe_lut_lookup(a, n_dot_v, roughness);

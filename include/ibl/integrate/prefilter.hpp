@@ -96,6 +96,7 @@
 #include "../sampling/ggx.hpp"
 #include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
+#include "chain.hpp"
 #include "ld_weight.hpp"
 #include "roughness_mip.hpp"
 #include "sphere_convolve.hpp"
@@ -291,7 +292,8 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 }
 } // namespace detail
 
-/// The prefiltered mip chain of an environment for lobe L (sampling/lobe.hpp; GGX by default,
+/// The prefiltered mip chain of an environment for lobe L (a specular_chain: the levels and the
+/// weight and mapping they were filtered with, integrate/chain.hpp) (sampling/lobe.hpp; GGX by default,
 /// prefilter<ibl::charlie_lobe>(env, opt) for sheen): level l holds LD for roughness
 /// opt.policy.roughness(l, levels) at face size max(1, base >> l). Level 0 is the copy of the
 /// source when the lobe's r = 0 limit is the mirror (GGX), else convolved at r = policy.roughness(0)
@@ -303,7 +305,7 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 /// 6 n_l^2 samples_l (x 2 when trilinear) > limits::max_work, before any work.
 template <class Lobe = ggx_lobe, class Env, class Executor = thread_executor>
     requires ld_lobe<Lobe>
-cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
+specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const int levels = prefilter_levels(opt, base);
     detail::check_prefilter_work(opt, base, levels);
@@ -324,7 +326,7 @@ cubemap<float> prefilter(const Env& env, const prefilter_options& opt = {}, Exec
         store(l, convolve_faces(env, table, out.size(l), ex));
     }
     out.update_borders();
-    return out;
+    return specular_chain(std::move(out), opt.weight, opt.policy.mapping);
 }
 
 } // namespace ibl
