@@ -111,6 +111,7 @@ def main():
     root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     tool = os.path.abspath(a.tool)
     failed = 0
+    outputs = {}  # the same command in several files runs once
     for path in a.files:
         full = os.path.join(root, path) if not os.path.isabs(path) else path
         lines = open(full, encoding="utf-8").read().split("\n")
@@ -119,7 +120,9 @@ def main():
             print(f"{path}: no generated block", file=sys.stderr)
             failed += 1
         for i, j, args in reversed(found):
-            got = run_tool(tool, args, root)
+            if args not in outputs:
+                outputs[args] = run_tool(tool, args, root)
+            got = outputs[args]
             body = lines[i + 1 : j]
             if a.write:
                 lines[i + 1 : j] = ["```"] + got.split("\n") + ["```"]
