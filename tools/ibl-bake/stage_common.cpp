@@ -237,11 +237,16 @@ std::vector<std::pair<std::string, std::string>> product_conventions(const bake_
             {"ibl.conventions", how_to_read}};
 }
 
-std::vector<std::pair<std::string, std::string>> table_layout_keys(const ibl::dfg_lut_layout& layout) {
-    return {{"ibl.dfg_layout", layout.name()},
-            {"ibl.dfg_lookup", layout == ibl::dfg_lut_layout::uniform()
-                                   ? "texture(lut, vec2(n.v, roughness)): texel (i, j) holds n.v = (i + 0.5) / N, r = (j + 0.5) / N"
-                                   : "texture(lut, ibl_dfg_lut_coord(n.v, roughness, N, layout)) (ibl/glsl/ibl_lookup.glsl)"}};
+std::vector<std::pair<std::string, std::string>> table_conventions(const bake_context& ctx, const std::string& product,
+                                                                   const std::string& how_to_read, const ibl::dfg_lut_layout& layout,
+                                                                   const std::vector<std::pair<std::string, std::string>>& extra) {
+    std::vector<std::pair<std::string, std::string>> m = product_conventions(ctx, product, how_to_read);
+    m.push_back({"ibl.dfg_layout", layout.name()});
+    m.push_back({"ibl.dfg_lookup", layout == ibl::dfg_lut_layout::uniform()
+                                       ? "texture(lut, vec2(n.v, roughness)): texel (i, j) holds n.v = (i + 0.5) / N, r = (j + 0.5) / N"
+                                       : "texture(lut, ibl_dfg_lut_coord(n.v, roughness, N, layout)) (ibl/glsl/ibl_lookup.glsl)"});
+    m.insert(m.end(), extra.begin(), extra.end());
+    return m;
 }
 
 product_view baked_view(const bake_context& ctx) {

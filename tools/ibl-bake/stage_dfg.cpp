@@ -41,13 +41,11 @@ public:
                                                       std::uint32_t(ctx.plan.dfg.channels), nodes_, ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lut;
-        attrs_ = product_conventions(ctx, "dfg",
-                                     std::string(filament_channels_ ? "R = B, G = A + B, B = k (specular = LD mix(R, G, F0))"
-                                                                    : "R = A, G = B, B = k (specular = LD (F0 A + F90 B))") +
-                                         "; EXR row 0 (top) is the smallest roughness");
-        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
-        attrs_.push_back({"ibl.model", lut_->model});
-        attrs_.push_back({"ibl.dfg_channels", filament_channels_ ? "B, A + B, k" : "A, B, k"});
+        attrs_ = table_conventions(ctx, "dfg",
+                                   std::string(filament_channels_ ? "R = B, G = A + B, B = k (specular = LD mix(R, G, F0))"
+                                                                  : "R = A, G = B, B = k (specular = LD (F0 A + F90 B))") +
+                                       "; EXR row 0 (top) is the smallest roughness",
+                                   layout_, {{"ibl.model", lut_->model}, {"ibl.dfg_channels", filament_channels_ ? "B, A + B, k" : "A, B, k"}});
         checked_ = ctx.opt.checks != "none";
         if (!checked_) return;
         ctx.prog.begin("check dfg");

@@ -77,21 +77,20 @@ public:
         ms_ = ctx.prog.end();
         lut_ = &*ctx.lobe;
         lut_b_ = &*ctx.lobe_b;
-        attrs_ = product_conventions(ctx, "lobe_lut", "R = A, G = B, B = s, A = r_eff: the two-part lobe model (with "
-                                                      "lobe_lut_b.exr) specular = F0 A LD(normalize(mix(n, R, s)), r_eff) + "
-                                                      "F90 B LD(d_B, r_B); a one-kernel reader: LD(normalize(mix(n, R, s)), "
-                                                      "r_eff) (F0 A + F90 B); LD from a chain of weight ibl.ld_weight");
-        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
-        attrs_.push_back({"ibl.ld_weight", weight_name_});
-        attrs_.push_back({"ibl.lobe_parts", "2: lobe_lut.exr (A part and A, B), lobe_lut_b.exr (the Fresnel B part)"});
-        attrs_b_ = product_conventions(ctx, "lobe_lut_b",
-                                       "R = f_B, G = r_B, B = 0, A = 0: the kernel of the lobe's Fresnel B part (weight "
-                                       "(1 - v.h)^5), read as LD(cos(a) n + sin(a) t, r_B), a = min(f_B acos(n.v), pi/2), t "
-                                       "the unit tangent of n towards R; specular = F0 A LD(normalize(mix(n, R, s)), r_eff) + "
-                                       "F90 B LD(d_B, r_B) with (A, B, s, r_eff) from lobe_lut.exr");
-        for (auto& kv : table_layout_keys(layout_)) attrs_b_.push_back(kv);
-        attrs_b_.push_back({"ibl.ld_weight", weight_name_});
-        attrs_b_.push_back({"ibl.lobe_parts", "2: lobe_lut.exr (A part and A, B), lobe_lut_b.exr (the Fresnel B part)"});
+        const std::vector<std::pair<std::string, std::string>> keys = {
+            {"ibl.ld_weight", weight_name_},
+            {"ibl.lobe_parts", "2: lobe_lut.exr (A part and A, B), lobe_lut_b.exr (the Fresnel B part)"}};
+        attrs_ = table_conventions(ctx, "lobe_lut",
+                                   "R = A, G = B, B = s, A = r_eff: the two-part lobe model (with lobe_lut_b.exr) specular = "
+                                   "F0 A LD(normalize(mix(n, R, s)), r_eff) + F90 B LD(d_B, r_B); a one-kernel reader: "
+                                   "LD(normalize(mix(n, R, s)), r_eff) (F0 A + F90 B); LD from a chain of weight ibl.ld_weight",
+                                   layout_, keys);
+        attrs_b_ = table_conventions(ctx, "lobe_lut_b",
+                                     "R = f_B, G = r_B, B = 0, A = 0: the kernel of the lobe's Fresnel B part (weight "
+                                     "(1 - v.h)^5), read as LD(cos(a) n + sin(a) t, r_B), a = min(f_B acos(n.v), pi/2), t the "
+                                     "unit tangent of n towards R; specular = F0 A LD(normalize(mix(n, R, s)), r_eff) + F90 B "
+                                     "LD(d_B, r_B) with (A, B, s, r_eff) from lobe_lut.exr",
+                                     layout_, keys);
         checked_ = ctx.opt.checks != "none";
         if (!checked_) return;
         ctx.prog.begin("check lobe lut");

@@ -73,11 +73,11 @@ public:
         ctx.taps = ibl::make_lobe_taps_lut<bake_model>(size, layout_, weight_, fit_options(), ctx.ex);
         ms_ = ctx.prog.end();
         lut_ = &*ctx.taps;
-        attrs_ = product_conventions(ctx, "lobe_taps", "lobe_taps_a = (A, B, a_0, r_0), lobe_taps_b = (w_0, a_1, r_1, w_1): "
-                                                       "specular = (F0 A + F90 B) sum_k w_k LD(cos(a_k acos(n.v)) n + sin(...) t, r_k) "
-                                                       "/ sum_k w_k (ibl_specular_lobe_taps2)");
-        for (auto& kv : table_layout_keys(layout_)) attrs_.push_back(kv);
-        attrs_.push_back({"ibl.ld_weight", weight_name_});
+        attrs_ = table_conventions(ctx, "lobe_taps",
+                                   "lobe_taps_a = (A, B, a_0, r_0), lobe_taps_b = (w_0, a_1, r_1, w_1): specular = (F0 A + "
+                                   "F90 B) sum_k w_k LD(cos(a_k acos(n.v)) n + sin(...) t, r_k) / sum_k w_k "
+                                   "(ibl_specular_lobe_taps2)",
+                                   layout_, {{"ibl.ld_weight", weight_name_}});
         checks_ = ctx.opt.checks;
         if (checks_ == "none") return;
         ctx.prog.begin("check lobe taps");

@@ -61,8 +61,7 @@ public:
         samples_ = po.samples_per_level;
         attrs_ = product_conventions(ctx, "sheen", "level l holds the Charlie-lobe LD at roughness l / (levels - 1) (linear), read "
                                                    "at R by textureLod(chain, R, lod(r))");
-        lut_attrs_ = product_conventions(ctx, "sheen_lut", "R = sheen albedo E(n.v, r) (Charlie NDF, Neubelt visibility)");
-        for (auto& kv : table_layout_keys(lut_.layout)) lut_attrs_.push_back(kv);
+        lut_attrs_ = table_conventions(ctx, "sheen_lut", "R = sheen albedo E(n.v, r) (Charlie NDF, Neubelt visibility)", lut_.layout);
         checked_ = ctx.opt.checks != "none";
         if (!checked_) return;
         ctx.prog.begin("check sheen");

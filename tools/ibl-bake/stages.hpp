@@ -170,9 +170,12 @@ product_view baked_view(const bake_context& ctx);
 std::vector<std::pair<std::string, std::string>> product_conventions(const bake_context& ctx, const std::string& product,
                                                                      const std::string& how_to_read);
 
-/// The keys of a (n.v, r) table: ibl.dfg_layout (ibl::dfg_lut_layout::name()) and ibl.dfg_lookup
-/// (how a shader computes the sampler coordinates).
-std::vector<std::pair<std::string, std::string>> table_layout_keys(const ibl::dfg_lut_layout& layout);
+/// The conventions of a (n.v, r) table's file: product_conventions, then ibl.dfg_layout
+/// (ibl::dfg_lut_layout::name()) and ibl.dfg_lookup (how a shader computes the sampler
+/// coordinates), then `extra`.
+std::vector<std::pair<std::string, std::string>> table_conventions(const bake_context& ctx, const std::string& product,
+                                                                   const std::string& how_to_read, const ibl::dfg_lut_layout& layout,
+                                                                   const std::vector<std::pair<std::string, std::string>>& extra = {});
 
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);

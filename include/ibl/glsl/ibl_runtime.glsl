@@ -353,6 +353,18 @@ vec3 ibl_lobe_pair_direction_b(vec3 n, vec3 r_dir, float stored, float n_dot_v) 
     return d * (1.0 / sqrt(dot(d, d)));
 }
 
+// The reads of the two-part lobe model at (n.v, r): pa = (A, B, s, r_eff) of lobe_lut, ld_a the LD
+// of the A part's kernel, ld_b that of the B part's (lobe_lut_b). Shared by the two functions below.
+void ibl_lobe_pair_reads(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, sampler2D lobe_lut_b,
+                         ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, out vec4 pa, out vec3 ld_a, out vec3 ld_b) {
+    float n_dot_v = ibl_saturate(dot(n, v));
+    vec3 r_dir = 2.0 * dot(n, v) * n - v;
+    pa = ibl_lobe_lut_lookup(lobe_lut, n_dot_v, roughness, lay);
+    vec4 pb = ibl_lobe_lut_lookup(lobe_lut_b, n_dot_v, roughness, lay);
+    ld_a = ibl_specular_lookup(chain, ibl_lerp_direction(n, r_dir, pa.z), pa.w, sd);
+    ld_b = ibl_specular_lookup(chain, ibl_lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+}
+
 // The products at a shading point through the two-part lobe model for a material (F0, F90): at
 // (n.v, r) (A, B, s, r_eff) = ibl_lobe_lut_lookup(lobe_lut) and (f_B, r_B) = ibl_lobe_lut_lookup(
 // lobe_lut_b) (lobe_lut.hpp, lobe_lut_b.hpp), LD_a at ibl_lobe_direction(n, v, s) and r_eff, LD_b at
@@ -362,24 +374,18 @@ vec3 ibl_lobe_pair_direction_b(vec3 n, vec3 r_dir, float stored, float n_dot_v) 
 ibl_sample ibl_lobe_pair_sample(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, sampler2D lobe_lut_b,
                                 ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90,
                                 vec3 irradiance_over_pi) {
-    float n_dot_v = ibl_saturate(dot(n, v));
-    vec3 r_dir = 2.0 * dot(n, v) * n - v;
-    vec4 pa = ibl_lobe_lut_lookup(lobe_lut, n_dot_v, roughness, lay);
-    vec4 pb = ibl_lobe_lut_lookup(lobe_lut_b, n_dot_v, roughness, lay);
-    vec3 ld_a = ibl_specular_lookup(chain, ibl_lerp_direction(n, r_dir, pa.z), pa.w, sd);
-    vec3 ld_b = ibl_specular_lookup(chain, ibl_lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+    vec4 pa;
+    vec3 ld_a, ld_b;
+    ibl_lobe_pair_reads(chain, sd, lobe_lut, lobe_lut_b, lay, n, v, roughness, pa, ld_a, ld_b);
     return ibl_sample(ibl_lobe_pair_ld(ld_a, ld_b, f0, f90, pa.xy), irradiance_over_pi, pa.xy);
 }
 
 // The two-part model's specular F0 A LD(d_A, r_eff) + F90 B LD(d_B, r_B) (specular_lobe_pair).
 vec3 ibl_specular_lobe_pair(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, sampler2D lobe_lut_b,
                             ibl_dfg_layout lay, vec3 n, vec3 v, float roughness, vec3 f0, vec3 f90) {
-    float n_dot_v = ibl_saturate(dot(n, v));
-    vec3 r_dir = 2.0 * dot(n, v) * n - v;
-    vec4 pa = ibl_lobe_lut_lookup(lobe_lut, n_dot_v, roughness, lay);
-    vec4 pb = ibl_lobe_lut_lookup(lobe_lut_b, n_dot_v, roughness, lay);
-    vec3 ld_a = ibl_specular_lookup(chain, ibl_lerp_direction(n, r_dir, pa.z), pa.w, sd);
-    vec3 ld_b = ibl_specular_lookup(chain, ibl_lobe_pair_direction_b(n, r_dir, pb.x, n_dot_v), pb.y, sd);
+    vec4 pa;
+    vec3 ld_a, ld_b;
+    ibl_lobe_pair_reads(chain, sd, lobe_lut, lobe_lut_b, lay, n, v, roughness, pa, ld_a, ld_b);
     return f0 * pa.x * ld_a + f90 * pa.y * ld_b;
 }
 
