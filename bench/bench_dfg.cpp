@@ -8,7 +8,7 @@
 // Run: ./build/release/bench/bench_dfg --benchmark_min_time=0.1
 #include <benchmark/benchmark.h>
 
-#include <ibl/integrate.hpp>
+#include <ibl/ibl.hpp>
 
 #include <cmath>
 #include <cstdint>

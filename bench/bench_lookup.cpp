@@ -1,4 +1,4 @@
-// bench_lookup: cost of the runtime lookups of ibl/lookup.hpp against their error.
+// bench_lookup: cost of the runtime lookups of ibl/runtime/lookup.hpp against their error.
 //   BM_specular_lookup/<scheme>: one lookup of a 256^2 x 6-level prefiltered chain of the default
 //     sky + sun (ibl-bake's default bake: filtered IS, trilinear, 512 spp at level 1 doubled per
 //     level) at a random direction and roughness in [0.25, 1]; counters: rel_rmse_worst = the
@@ -14,10 +14,10 @@
 
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/lookup.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/lookup.hpp>
 #include <ibl/sampling/sequence.hpp>
 
 #include <algorithm>

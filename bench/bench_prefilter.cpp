@@ -1,4 +1,4 @@
-// integrate/prefilter and irradiance: the cost of the prefiltered mip chain (256^2 source -> 5
+// bake/prefilter and irradiance: the cost of the prefiltered mip chain (256^2 source -> 5
 // levels, linear roughness policy) against its error, sweeping samples per texel for plain GGX
 // importance sampling (IS) and filtered importance sampling (FIS), on
 //   env 0: the default sky without its sun (smooth), baked to 256^2 (k = 2);
@@ -12,10 +12,10 @@
 
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
-#include <ibl/integrate/irradiance.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/bake/irradiance.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 #include <array>
 #include <string>

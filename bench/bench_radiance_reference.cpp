@@ -1,4 +1,4 @@
-// integrate/radiance_reference.hpp: cost against error of the outgoing-radiance reference on the
+// reference/radiance.hpp: cost against error of the outgoing-radiance reference on the
 // stiff case (the default sky's 1-degree sun reflected by a dielectric, n = +Y, R at the sun),
 // for MIS and for BRDF sampling alone, swept over the sample count. Counters: rel_err = |estimate
 // / converged - 1| (converged: MIS at 2^22 samples, computed once), rel_se = the estimator's own
@@ -6,8 +6,8 @@
 #include <benchmark/benchmark.h>
 
 #include <ibl/env/analytic.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/radiance.hpp>
 
 #include <cmath>
 #include <cstdint>

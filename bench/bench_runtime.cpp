@@ -1,4 +1,4 @@
-// bench_runtime: cost of the runtime approximations of ibl/runtime.hpp next to their error.
+// bench_runtime: cost of the runtime approximations of ibl/runtime/specular_models.hpp next to their error.
 //   BM_runtime_specular/<variant>: one specular evaluation (metal F0 = (0.95, 0.64, 0.54)) at a
 //     random (n, v, r) of a fixed set, on a 256^2 x 6-level chain of the default sky + sun
 //     (ibl-bake's default bake, G1 weight for the variants that say so). Counters:
@@ -9,7 +9,7 @@
 //       taps     = chain textureLod reads per evaluation (the LUT tap comes on top where used).
 //     variants: 0 split sum (n.l chain), 1 split sum (G1 chain), 2 Frostbite dominant direction
 //     (n.l chain), 3 lobe LUT (G1 chain), 4 FIS 8 taps, 5 FIS 16 taps, 6 FIS 64 taps (normalised,
-//     G1 chain), 7 fitted lobe LUT (one tap, L1 fit; integrate/lobe_fit.hpp), 8 fitted 2 taps,
+//     G1 chain), 7 fitted lobe LUT (one tap, L1 fit; bake/lobe_fit.hpp), 8 fitted 2 taps,
 //     9 fitted 3 taps (G1 chain; 32^2 tables).
 //   BM_lobe_fit_table/<taps>: building the fitted table (make_lobe_taps_lut) of 1 tap (default fit
 //     options, what make_lobe_lut_fitted runs), 2 or 3 taps (make_lobe_taps_lut, 32 nodes, 150 iterations) at 32^2, 2 threads;
@@ -20,13 +20,13 @@
 #include <ibl/core/color.hpp>
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/integrate/lobe_lut.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/runtime/specular_models.hpp>
 
 #include <cmath>
 #include <cstdint>

@@ -8,10 +8,10 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/sun_extract.hpp>
-#include <ibl/integrate/disk_light.hpp>
-#include <ibl/integrate/irradiance.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/reference/disk_light.hpp>
+#include <ibl/bake/irradiance.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #include <algorithm>
 #include <cmath>

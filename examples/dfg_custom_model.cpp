@@ -8,7 +8,7 @@
 //   =>  D_beckmann / D_ggx = (1 + x)^2 exp(-x)   (<= 4/e).
 // The program prints the model's (A, B) by quadrature and by Monte Carlo, and the error of the
 // Monte Carlo table against the exact one, then writes the exact table as a C++ header.
-#include <ibl/integrate.hpp>
+#include <ibl/ibl.hpp>
 
 #include <cmath>
 #include <cstdio>

@@ -1,6 +1,6 @@
-// examples/lookup_error.cpp — what a renderer gets: the error of the runtime lookups (ibl/lookup.hpp)
+// examples/lookup_error.cpp — what a renderer gets: the error of the runtime lookups (ibl/runtime/lookup.hpp)
 // at roughness between the baked levels and at n.v, r between the DFG table's texels, measured by
-// integrate/lookup_error.hpp against exact references. The tables of docs/lookup.md come from here.
+// reference/lookup_error.hpp against exact references. The tables of docs/lookup.md come from here.
 //
 //   lookup_error            both parts
 //   lookup_error dfg        DFG table sizes x layouts x storage (float / half)
@@ -35,10 +35,10 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/lookup.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/lookup.hpp>
 
 #if defined(IBL_EXAMPLES_DATA_DIR)
 #include "image_io.hpp"

@@ -1,5 +1,5 @@
 // examples/occlusion_error.cpp — specular occlusion against the occluded reference
-// (integrate/occlusion.hpp): the environment is visible only inside a cone of half-angle theta_o
+// (reference/occluded_specular.hpp): the environment is visible only inside a cone of half-angle theta_o
 // about a bent normal b, and the reference integrates f_s L V (n.l) in full (MIS, no split sum).
 // The tables of docs/occlusion.md come from here.
 //
@@ -11,9 +11,9 @@
 // F90 B). Occlusion variants multiply it by a factor k:
 //   none      k = 1
 //   ao        k = ao
-//   Lagarde   k = specular_occlusion_lagarde(n.v, ao, r) (ibl/runtime.hpp)
+//   Lagarde   k = specular_occlusion_lagarde(n.v, ao, r) (ibl/runtime/specular_models.hpp)
 //   lobe LUT  k = so(n.v, r, ao): the visible fraction of the lobe in a cone about n
-//             (ibl/occlusion.hpp, make_specular_occlusion_lut 16^3, 256^2 nodes per cell)
+//             (ibl/runtime/specular_occlusion.hpp, make_specular_occlusion_lut 16^3, 256^2 nodes per cell)
 //   lobe LUT, bent   k = so(b.R, r, ao / b.n): the same table with the lobe's direction measured
 //             from the bent normal (b.R for n.v) and the cone's own aperture (ao = cos(beta)
 //             sin^2 theta_o inverted without the horizon clip); equal to "lobe LUT" for b = n
@@ -45,13 +45,13 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/occlusion.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/occlusion.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/reference/occluded_specular.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/runtime/specular_occlusion.hpp>
+#include <ibl/runtime/specular_models.hpp>
 
 #include "study_envs.hpp"
 

@@ -1,11 +1,11 @@
-// examples/runtime_error.cpp — the runtime approximations of ibl/runtime.hpp against the full
+// examples/runtime_error.cpp — the runtime approximations of ibl/runtime/specular_models.hpp against the full
 // integral: each variant's specular radiance against ibl::reference_radiance (MIS of the BRDF and
 // the environment, no split sum), over random normals and views at fixed n.v. The tables of
 // docs/runtime.md come from here.
 //
 //   runtime_error [quick|explore|fit] [levels=N]
 //     quick: 8 points per cell, 2^13 reference samples (a smoke run); explore: FIS footprint
-//     scales; fit: the per-cell L1 fits of 1, 2, 3, 6 and 8 taps (integrate/lobe_fit.hpp, no table)
+//     scales; fit: the per-cell L1 fits of 1, 2, 3, 6 and 8 taps (bake/lobe_fit.hpp, no table)
 //     against their 32^2 tables; levels=N: a chain of N levels (default 6, as ibl-bake).
 //
 // Environments: the built-in sky + sun (ibl::make_default_sky; integrand analytic) and
@@ -41,14 +41,14 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/integrate/lobe_lut.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/specular_models.hpp>
 
 #include "study_envs.hpp"
 

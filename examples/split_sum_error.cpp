@@ -1,6 +1,6 @@
 // examples/split_sum_error.cpp — how wrong is the split sum? Outgoing radiance of glossy materials
 // under an environment, by the split-sum product (what a renderer evaluates at run time) against
-// the reference integral without the approximation (integrate/radiance_reference.hpp).
+// the reference integral without the approximation (reference/radiance.hpp).
 //
 // For each environment (the built-in default sky with its 1-degree sun, and tests/data/courtyard.exr
 // when the example is built with the ibl-bake image reader), each normal / view and each material
@@ -41,11 +41,11 @@
 #include <ibl/core/frame.hpp>
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/radiance.hpp>
 #include <ibl/sampling/ggx.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #if defined(IBL_EXAMPLES_DATA_DIR)
 #include "image_io.hpp"

@@ -16,8 +16,8 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/radiance.hpp>
 
 #if defined(IBL_EXAMPLES_DATA_DIR)
 #include "image_io.hpp"

@@ -1,22 +1,20 @@
 # tests/header_deps.cmake — the include-dependency rules of the library's layers (pay
-# only for what you include). For each umbrella / top-level header, the compiler's dependency
-# list (-M: every file the preprocessor opens) must contain only ibl headers under the allowed
-# prefixes. A layer that starts including a higher one (sh/ pulling in integrate/ prefilter code,
-# brdf/ pulling in sampling/) fails this test. The rules (docs/ARCHITECTURE.md, "Dependency rules"):
+# only for what you include). The layers, bottom up (docs/ARCHITECTURE.md, "Layers"):
+#     core < brdf, sampling, env < sh, batch < runtime < bake < reference
+# For each layer header and each header under a layer folder, the compiler's dependency list
+# (-M: every file the preprocessor opens) must contain only ibl headers under the allowed
+# prefixes: a layer that starts including a higher one (runtime/ pulling in a baker, bake/ pulling
+# in a reference, sh/ pulling in prefilter code) fails this test. Finer rules inside a layer:
 #
-#   ibl/core.hpp      core/
-#   ibl/brdf.hpp      core/ brdf/                       (no sampling/: sampling sits above brdf)
-#   ibl/sampling.hpp  core/ brdf/ sampling/
-#   ibl/env.hpp       core/ env/                        (no integrate/, sh/, batch/)
-#   ibl/sh.hpp        core/ sh/ env/cube_geometry.hpp   (no integrate/, batch/: no prefilter code)
-#   ibl/shade.hpp     core/ brdf/                       (takes products as values, bakes nothing)
-#   ibl/plan.hpp      core/ integrate/roughness_mip.hpp (the plan is arithmetic, no integrator)
-#   ibl/lookup.hpp    core/ brdf/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp (runtime lookups: no
-#                     integrator, no DFG table code; tables are read through their members)
-#   ibl/runtime.hpp   core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp lookup.hpp
-#                     (runtime approximations: reads the chain and tables, bakes nothing)
-#   ibl/batch.hpp     core/ brdf/ sampling/ env/ batch/ (kernels; never integrate/, which calls them)
-#   ibl/batch/**.hpp  the same, for every header under batch/ (also one the umbrella leaves out)
+#   ibl/sh.hpp               core/ sh/ env/cube_geometry.hpp (no batch/ or prefilter code)
+#   runtime/shade.hpp        core/ brdf/           (takes products as values, reads no table code)
+#   runtime/lookup.hpp       core/ brdf/ env/ runtime/ (no integrator, no table builder)
+#   bake/plan.hpp            core/ runtime/roughness_mip.hpp (the plan is arithmetic, no integrator)
+#   batch/**.hpp             core/ brdf/ sampling/ env/ batch/ (kernels; never bake/, which calls them)
+#
+# Research (the top-level research/ folder: studies, baselines, tuning programs) is never
+# included by an installed header: every file under include/ibl is scanned for an #include
+# that names research/.
 #
 # A header field with a '*' is a glob (relative to include/ibl, recursive): each match is checked.
 # usage: cmake -DCXX=<compiler> -DINCLUDE_DIR=<repo>/include -DGLM_INCLUDE=<dirs;...>
@@ -25,16 +23,33 @@ cmake_minimum_required(VERSION 3.21)
 
 set(rules
     "core.hpp|core/"
+    "core/*.hpp|core/"
     "brdf.hpp|core/ brdf/"
     "sampling.hpp|core/ brdf/ sampling/"
     "env.hpp|core/ env/"
     "sh.hpp|core/ sh/ env/cube_geometry.hpp"
-    "shade.hpp|core/ brdf/"
-    "plan.hpp|core/ integrate/roughness_mip.hpp"
-    "lookup.hpp|core/ brdf/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp"
-    "runtime.hpp|core/ brdf/ sampling/ env/ integrate/roughness_mip.hpp integrate/dfg_layout.hpp shade.hpp lookup.hpp"
     "batch.hpp|core/ brdf/ sampling/ env/ batch/"
-    "batch/*.hpp|core/ brdf/ sampling/ env/ batch/")
+    "batch/*.hpp|core/ brdf/ sampling/ env/ batch/"
+    "runtime.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/"
+    "runtime/*.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/"
+    "runtime/shade.hpp|core/ brdf/"
+    "runtime/lookup.hpp|core/ brdf/ env/ runtime/"
+    "bake.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/"
+    "bake/*.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/"
+    "bake/plan.hpp|core/ runtime/roughness_mip.hpp"
+    "reference.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/ reference/"
+    "reference/*.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/ reference/")
+
+# No installed header includes research/.
+file(GLOB_RECURSE installed RELATIVE ${INCLUDE_DIR} ${INCLUDE_DIR}/ibl/*)
+set(research_failed 0)
+foreach(f IN LISTS installed)
+    file(STRINGS ${INCLUDE_DIR}/${f} hits REGEX "^[ \t]*#[ \t]*include[ \t]*[<\"].*research")
+    if(hits)
+        message(SEND_ERROR "${f} includes research code: ${hits}")
+        set(research_failed 1)
+    endif()
+endforeach()
 
 file(MAKE_DIRECTORY ${WORK_DIR})
 file(REAL_PATH ${INCLUDE_DIR}/ibl IBL_DIR)
@@ -44,7 +59,7 @@ foreach(d IN LISTS GLM_INCLUDE)
         list(APPEND glm_flags "-I${d}")
     endif()
 endforeach()
-set(failed 0)
+set(failed ${research_failed})
 set(expanded "")
 foreach(rule IN LISTS rules)
     string(REPLACE "|" ";" parts "${rule}")

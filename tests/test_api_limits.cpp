@@ -7,8 +7,8 @@
 #include <ibl/core/gauss_legendre.hpp>
 #include <ibl/core/limits.hpp>
 #include <ibl/env.hpp>
-#include <ibl/integrate.hpp>
-#include <ibl/plan.hpp>
+#include <ibl/ibl.hpp>
+#include <ibl/bake/plan.hpp>
 #include <ibl/sh.hpp>
 
 #include <climits>

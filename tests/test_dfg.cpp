@@ -1,11 +1,11 @@
-// integrate/dfg*, batch/dfg_kernel: split-sum DFG terms by quadrature and Monte Carlo, their
+// bake/dfg*, batch/dfg_kernel: split-sum DFG terms by quadrature and Monte Carlo, their
 // limits, the batch kernels against the scalar paths, executor determinism, the multiple-scattering
 // channel, the LUT exporter and the analytic fit. Heavy convergence figures live in
 // bench/bench_dfg.cpp; here the checks are on subsets (every test runs in well under a second).
 #include <doctest/doctest.h>
 
 #include <ibl/batch.hpp>
-#include <ibl/integrate.hpp>
+#include <ibl/ibl.hpp>
 
 #include <cmath>
 #include <cstdint>

@@ -1,12 +1,12 @@
-// integrate/irradiance: Riemann (the literature's) and cosine-importance irradiance, E convention.
+// bake/irradiance: Riemann (the literature's) and cosine-importance irradiance, E convention.
 #include <doctest/doctest.h>
 
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/irradiance.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/bake/irradiance.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 #include <cmath>
 #include <cstring>

@@ -17,7 +17,7 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/irradiance.hpp>
+#include <ibl/bake/irradiance.hpp>
 #include <ibl/sampling/hemisphere.hpp>
 #include <ibl/sampling/lobe.hpp>
 #include <ibl/sampling/sequence.hpp>

@@ -1,4 +1,4 @@
-// tests/test_ld_weight.cpp — the G1 LD weight (integrate/ld_weight.hpp) in the references that a
+// tests/test_ld_weight.cpp — the G1 LD weight (runtime/ld_weight.hpp) in the references that a
 // G1-weighted chain is checked against: the normaliser, reference_ld, the texel sum, the disk
 // light's LD term and reference_ld_sky, each against an independent computation.
 
@@ -7,9 +7,9 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/disk_light.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/disk_light.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/sampling/lobe.hpp>
 #include <ibl/sampling/sequence.hpp>
 

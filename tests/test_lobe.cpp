@@ -8,10 +8,10 @@
 
 #include <ibl/brdf/model.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/sampling/lobe.hpp>
 
 #include <doctest/doctest.h>

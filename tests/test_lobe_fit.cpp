@@ -1,4 +1,4 @@
-// tests/test_lobe_fit.cpp — the lobe fit (integrate/lobe_fit.hpp) and the fitted-taps runtime
+// tests/test_lobe_fit.cpp — the lobe fit (bake/lobe_fit.hpp) and the fitted-taps runtime
 // (runtime.hpp): the chain kernel's normaliser and density against an independent quadrature in
 // the polar angle, its mass below the horizon against a sphere quadrature, the L1 estimator over the lobe's draws against a direct quadrature of |p - q|
 // over the whole sphere (p from the model's D and V, normalised by dfg_exact), the fit's exact
@@ -18,9 +18,9 @@
 
 #include <ibl/brdf/model.hpp>
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/runtime/specular_models.hpp>
 
 #include <array>
 #include <cmath>

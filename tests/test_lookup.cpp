@@ -1,5 +1,5 @@
-// tests/test_lookup.cpp — the runtime lookups (ibl/lookup.hpp) and their error metrics
-// (integrate/lookup_error.hpp): hand cases of the specular taps (a level's own roughness returns
+// tests/test_lookup.cpp — the runtime lookups (ibl/runtime/lookup.hpp) and their error metrics
+// (reference/lookup_error.hpp): hand cases of the specular taps (a level's own roughness returns
 // that level, weights sum to 1, a constant environment is exact), the DFG layouts (texel centres
 // return the texel, the remap's inverse, the uniform layout is dfg_lut.hpp's table), the default
 // DFG layout's error on a dense grid against the exact quadrature, the half rounding, and the
@@ -8,8 +8,8 @@
 #include <doctest/doctest.h>
 
 #include <ibl/brdf/model.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/lookup.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/runtime/lookup.hpp>
 
 #include <cmath>
 #include <cstdint>

@@ -1,5 +1,5 @@
 // tests/test_occlusion.cpp — the occluded specular reference, the cone's ambient occlusion and the
-// visible-fraction table (integrate/occlusion.hpp, ibl/occlusion.hpp).
+// visible-fraction table (reference/occluded_specular.hpp, ibl/runtime/specular_occlusion.hpp).
 //
 // Tolerances: Monte Carlo estimates within 4 standard errors of their 16 batch means (the
 // convention of test_radiance_reference.cpp: P(|t_15| > 4) = 1.2e-3, results deterministic);
@@ -20,10 +20,10 @@
 #include <ibl/core/frame.hpp>
 #include <ibl/core/gauss_legendre.hpp>
 #include <ibl/env/analytic.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/occlusion.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/occlusion.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/occluded_specular.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/runtime/specular_occlusion.hpp>
 
 namespace {
 

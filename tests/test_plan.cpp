@@ -1,8 +1,8 @@
-// tests/test_plan.cpp — the scene-driven bake plan (include/ibl/plan.hpp): decisions for
+// tests/test_plan.cpp — the scene-driven bake plan (include/ibl/bake/plan.hpp): decisions for
 // archetypal scenes, monotonicity in the error target, bad input.
 #include <doctest/doctest.h>
 
-#include <ibl/plan.hpp>
+#include <ibl/bake/plan.hpp>
 
 #include <cmath>
 #include <limits>

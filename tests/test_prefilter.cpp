@@ -1,13 +1,13 @@
-// integrate/prefilter, roughness_mip, reference, metrics: the prefiltered specular mip chain.
+// bake/prefilter, runtime/roughness_mip, reference/ld_irradiance, reference/metrics: the prefiltered specular mip chain.
 #include <doctest/doctest.h>
 
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/integrate/roughness_mip.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/roughness_mip.hpp>
 
 #include <algorithm>
 #include <cmath>

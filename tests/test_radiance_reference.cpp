@@ -1,5 +1,5 @@
 // tests/test_radiance_reference.cpp — the outgoing-radiance reference without the split sum
-// (integrate/radiance_reference.hpp) and its environment distribution (integrate/env_importance.hpp).
+// (reference/radiance.hpp) and its environment distribution (reference/env_importance.hpp).
 //
 // Tolerances on Monte Carlo estimates are in units of the estimator's own standard error (from
 // 16 independent randomisations): |estimate - truth| <= 4 se. With 16 batches the studentised
@@ -22,9 +22,9 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/radiance.hpp>
 
 #include "support/stats.hpp"
 
@@ -225,7 +225,7 @@ TEST_CASE("radiance reference: white furnace") {
             m.roughness = r;
             const ibl::radiance_estimate e = ibl::reference_radiance(white, dist, n, view_at(n, mu, 1.0), m, opt);
             const vec2<double> ab = ibl::dfg_exact<ibl::ggx_height_correlated>(mu, r);
-            // dfg_exact converges to <= 1e-6 (integrate/dfg.hpp).
+            // dfg_exact converges to <= 1e-6 (bake/dfg.hpp).
             CHECK(std::fabs(e.value.x - (ab.x + ab.y)) <= k_sigma * e.std_error.x + 1e-6);
             CHECK(e.value.x == e.value.y); // F = 1 and L = 1 in every channel: identical channels
             // 4096 samples against an integrand of variance < 1: se well below 1%.

@@ -1,4 +1,4 @@
-// tests/test_shade.cpp — the runtime combination of the products (ibl/shade.hpp) as a
+// tests/test_shade.cpp — the runtime combination of the products (ibl/runtime/shade.hpp) as a
 // specification: white-furnace identities of the multiple-scattering model, energy bounds of
 // both ambient variants (including the documented excess of the single-scattering heuristic),
 // a hand-computed Cook-Torrance value, metals without diffuse, inverse-square falloff, and a
@@ -10,7 +10,7 @@
 
 #include <doctest/doctest.h>
 
-#include <ibl/shade.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #include <cmath>
 #include <limits>

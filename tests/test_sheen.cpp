@@ -9,9 +9,9 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/integrate/sheen.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/bake/sheen.hpp>
 #include <ibl/sampling/charlie.hpp>
 #include <ibl/sampling/lobe.hpp>
 

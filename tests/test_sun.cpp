@@ -1,6 +1,6 @@
-// A sun: the texel-moment irradiance map (integrate/irradiance.hpp), sun extraction
+// A sun: the texel-moment irradiance map (bake/irradiance.hpp), sun extraction
 // (env/sun_extract.hpp), the disk light's diffuse and specular forms (shade.hpp) and its LD
-// quadrature (integrate/disk_light.hpp), against closed forms and brute-force sums.
+// quadrature (reference/disk_light.hpp), against closed forms and brute-force sums.
 #include <doctest/doctest.h>
 
 #include <ibl/core/executor.hpp>
@@ -9,12 +9,12 @@
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
 #include <ibl/env/sun_extract.hpp>
-#include <ibl/integrate/disk_light.hpp>
-#include <ibl/integrate/irradiance.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/disk_light.hpp>
+#include <ibl/bake/irradiance.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #include <algorithm>
 #include <cmath>

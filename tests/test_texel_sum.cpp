@@ -1,4 +1,4 @@
-// integrate/reference.hpp: irradiance_texel_sum, the brute-force irradiance over the texels of one
+// reference/ld_irradiance.hpp: irradiance_texel_sum, the brute-force irradiance over the texels of one
 // cubemap level, against closed forms (constant sky, cosine-lobe sky), exact single-texel sums and
 // the summation order it documents.
 #include <doctest/doctest.h>
@@ -8,7 +8,7 @@
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/sampling/sequence.hpp>
 
 #include <algorithm>

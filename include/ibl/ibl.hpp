@@ -1,16 +1,15 @@
 #pragma once
-// ibl/ibl.hpp — the umbrella header: every layer of the library. Include the layer headers
-// (ibl/core.hpp, ibl/brdf.hpp, ibl/sampling.hpp, ibl/env.hpp, ibl/integrate.hpp, ...) or single
-// files to pay only for what you use.
-#include "batch.hpp"
-#include "brdf.hpp"
+// ibl/ibl.hpp — the umbrella header: every shipping layer of the library, from the bottom up
+// (core < brdf, sampling, env < sh, batch < runtime < bake < reference; docs/ARCHITECTURE.md).
+// Include a layer header (ibl/core.hpp, ..., ibl/runtime.hpp, ibl/bake.hpp, ibl/reference.hpp) or
+// single files to pay only for what you use.
 #include "core.hpp"
 #include "core/executor.hpp"
-#include "env.hpp"
-#include "integrate.hpp"
-#include "lookup.hpp"
-#include "plan.hpp"
-#include "runtime.hpp"
+#include "brdf.hpp"
 #include "sampling.hpp"
-#include "shade.hpp"
+#include "env.hpp"
 #include "sh.hpp"
+#include "batch.hpp"
+#include "runtime.hpp"
+#include "bake.hpp"
+#include "reference.hpp"

@@ -1,5 +1,5 @@
 // tests/browser/glsl_reference.cpp — the grid of tools/viewer/numeric.frag.glsl evaluated by the
-// C++ library in float (ibl/lookup.hpp, ibl/shade.hpp, ibl/sh/convolve.hpp), printed as JSON for
+// C++ library in float (ibl/runtime/lookup.hpp, ibl/runtime/shade.hpp, ibl/sh/convolve.hpp), printed as JSON for
 // run_browser_test.py --mode numeric. Each row names the function and its bound: relative `rel`
 // plus absolute `abs` (docs/shaders.md derives them).
 
@@ -14,11 +14,11 @@
 
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
-#include <ibl/integrate/occlusion.hpp>
-#include <ibl/lookup.hpp>
-#include <ibl/occlusion.hpp>
-#include <ibl/runtime.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/reference/occluded_specular.hpp>
+#include <ibl/runtime/lookup.hpp>
+#include <ibl/runtime/specular_occlusion.hpp>
+#include <ibl/runtime/specular_models.hpp>
+#include <ibl/runtime/shade.hpp>
 #include <ibl/sh/convolve.hpp>
 
 namespace {

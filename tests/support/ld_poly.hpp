@@ -4,7 +4,7 @@
 // moments by quadrature of an NDF, and the bound of a sample table's LD error from its moments.
 
 #include <ibl/core/vec.hpp>
-#include <ibl/integrate/sphere_convolve.hpp>
+#include <ibl/bake/sphere_convolve.hpp>
 
 #include <cmath>
 #include <cstddef>

@@ -2,7 +2,7 @@
 
 #include "bake_options.hpp"
 
-#include <ibl/integrate/prefilter.hpp>
+#include <ibl/bake/prefilter.hpp>
 
 #include <algorithm>
 #include <charconv>

@@ -51,7 +51,7 @@
 #include <string>
 #include <vector>
 
-#include <ibl/integrate/dfg.hpp>
+#include <ibl/bake/dfg.hpp>
 
 namespace ibl_bake {
 

@@ -27,12 +27,12 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/cubemap.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/dfg_lut.hpp>
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/integrate/lobe_lut.hpp>
-#include <ibl/plan.hpp>
+#include <ibl/bake/dfg_lut.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/plan.hpp>
 #include <ibl/sh/basis.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #include "bake_exec.hpp"
 #include "bake_options.hpp"

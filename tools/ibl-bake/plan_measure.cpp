@@ -1,5 +1,5 @@
 // tools/ibl-bake/plan_measure.cpp — the measurements behind the decision tables of
-// include/ibl/plan.hpp. Run it after changing an integrator and update the tables.
+// include/ibl/bake/plan.hpp. Run it after changing an integrator and update the tables.
 //
 //   1. DFG LUT: the largest bilinear-interpolation error of an exact N^2 table (clamp-to-edge, as
 //      a GPU samples it) against dfg_exact at off-grid points, N = 16 .. 256. The points are a
@@ -34,11 +34,11 @@
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/dfg_lut.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/dfg_lut.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
 #include <ibl/sh/window.hpp>

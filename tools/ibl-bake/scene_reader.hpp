@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <ibl/plan.hpp>
+#include <ibl/bake/plan.hpp>
 
 namespace ibl_bake {
 

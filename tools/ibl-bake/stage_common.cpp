@@ -11,13 +11,13 @@
 #include <ibl/core/color.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/prefilter.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/prefilter.hpp>
 #include <ibl/brdf/charlie.hpp>
-#include <ibl/integrate/disk_light.hpp>
+#include <ibl/reference/disk_light.hpp>
 #include <ibl/sampling/lobe.hpp>
-#include <ibl/integrate/reference.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/runtime/specular_models.hpp>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>
 
@@ -216,7 +216,7 @@ void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s,
     j.key("interpolation").value(textbook ? "linear" : "geometric");
     j.key("rule").value(textbook ? "textureLod(chain, R, lod(r)): lerp of levels l, l+1 at t = frac(lod)"
                                  : "levels l, l+1 bracketing r; t linear in log r between their roughness; "
-                                   "L = L_l^(1-t) L_{l+1}^t per channel (ibl/lookup.hpp)");
+                                   "L = L_l^(1-t) L_{l+1}^t per channel (ibl/runtime/lookup.hpp)");
     j.end_object();
     j.key("dfg_layout").begin_object();
     j.key("n_dot_v").value(axis_name(d.n_dot_v)).key("roughness").value(axis_name(d.roughness));

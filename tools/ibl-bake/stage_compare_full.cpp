@@ -21,11 +21,11 @@
 #include <ibl/core/frame.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/dfg_lut.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/bake/dfg_lut.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/reference/radiance.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 #include "check_texels.hpp"
 

@@ -1,5 +1,5 @@
 // tools/ibl-bake/stage_dfg.cpp — the split-sum DFG table of the plan's size and channels by exact
-// quadrature (ibl::make_dfg_lut_exact) in the table layout of --dfg-layout (ibl/lookup.hpp; the
+// quadrature (ibl::make_dfg_lut_exact) in the table layout of --dfg-layout (ibl/runtime/lookup.hpp; the
 // default puts texels in cbrt(n.v) and sqrt(r), edge-aligned): A, B and, with 3 channels, the
 // multiscatter k = (1 - E)/E. Checks: a 16 x 16 grid of texels (fewer for a smaller table) against
 // ibl::dfg_exact at the texels' own (n.v, r); and the lookup a shader makes (ibl::dfg_lookup,
@@ -12,9 +12,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/dfg_export.hpp>
-#include <ibl/integrate/lookup_error.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/dfg_export.hpp>
+#include <ibl/reference/lookup_error.hpp>
 
 namespace ibl_bake {
 

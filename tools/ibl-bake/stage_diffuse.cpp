@@ -25,7 +25,7 @@
 #include <cmath>
 
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/irradiance.hpp>
+#include <ibl/bake/irradiance.hpp>
 #include <functional>
 #include <ibl/sh/convolve.hpp>
 #include <ibl/sh/project.hpp>

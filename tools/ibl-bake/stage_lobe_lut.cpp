@@ -1,5 +1,5 @@
 // tools/ibl-bake/stage_lobe_lut.cpp — the tables of the two-part lobe model (--runtime lobe;
-// ibl/runtime.hpp specular_lobe_pair, integrate/lobe_fit.hpp make_lobe_pair_lut): per (n.v, r)
+// ibl/runtime/specular_models.hpp specular_lobe_pair, bake/lobe_fit.hpp make_lobe_pair_lut): per (n.v, r)
 // the DFG terms A, B, the lerp factor s and the chain roughness r_eff of the one chain kernel
 // closest to the specular lobe in L1 (read for F0 A), and the kernel closest to the lobe's
 // Fresnel B part (weight (1 - v.h)^5, read for F90 B): its angle from n over acos(n.v) and its
@@ -27,8 +27,8 @@
 #include <cmath>
 #include <sstream>
 
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/runtime/specular_models.hpp>
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic pop
 #endif
@@ -195,7 +195,7 @@ std::vector<file_out> lobe_lut_stage::files() const {
     return {{"lobe_lut.exr",
              [this](const std::string& p) { write_exr_rgba(p, image_rgba32f{int(lut_->size), int(lut_->size), lut_->data}, attrs_); }},
             {"lobe_lut.hpp", [this, rule](const std::string& p) {
-                 write_text(p, c_table_header("lobe_lut", std::string("the lobe LUT of ibl/runtime.hpp (") + bake_model::name +
+                 write_text(p, c_table_header("lobe_lut", std::string("the lobe LUT of ibl/runtime/specular_models.hpp (") + bake_model::name +
                                                               ", chain weight " + weight_name_ + ")",
                                               lut_->size, 4, "A, B, s, r_eff", rule, lut_->data));
              }},
@@ -204,7 +204,7 @@ std::vector<file_out> lobe_lut_stage::files() const {
                  write_exr_rgba(p, image_rgba32f{int(lut_b_->size), int(lut_b_->size), lut_b_->data}, attrs_b_);
              }},
             {"lobe_lut_b.hpp", [this, rule](const std::string& p) {
-                 write_text(p, c_table_header("lobe_lut_b", std::string("the lobe model's B-part kernel table of ibl/runtime.hpp (") +
+                 write_text(p, c_table_header("lobe_lut_b", std::string("the lobe model's B-part kernel table of ibl/runtime/specular_models.hpp (") +
                                                                 bake_model::name + ", chain weight " + weight_name_ + ")",
                                               lut_b_->size, 4, "f_B (angle over acos(n.v)), r_B, 0, 0", rule, lut_b_->data));
              }}};

@@ -1,5 +1,5 @@
 // tools/ibl-bake/stage_lobe_taps.cpp — the two-tap table of the runtime model taps2 (--runtime
-// taps2; ibl/runtime.hpp specular_lobe_taps, integrate/lobe_fit.hpp): per (n.v, r) the DFG terms
+// taps2; ibl/runtime/specular_models.hpp specular_lobe_taps, bake/lobe_fit.hpp): per (n.v, r) the DFG terms
 // A, B and the two chain kernels (angle from n towards R, roughness, weight) whose mixture is
 // closest to the specular lobe in L1 (ibl::make_lobe_taps_lut, taps = 2, the chain's weight), in
 // the DFG table's layout at lobe_lut_size_for(DFG size) texels per side, each texel fitted on its
@@ -19,8 +19,8 @@
 #include <cmath>
 #include <sstream>
 
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/runtime/specular_models.hpp>
 
 namespace ibl_bake {
 
@@ -170,7 +170,7 @@ std::vector<file_out> lobe_taps_stage::files() const {
             {"lobe_taps_b.exr", [this](const std::string& p) { write_exr_rgba(p, taps_image(*lut_, 4), attrs_); }},
             {"lobe_taps.hpp", [this, rule](const std::string& p) {
                  write_text(p, c_table_header("lobe_taps",
-                                              std::string("the two-tap table of ibl/runtime.hpp specular_lobe_taps (") +
+                                              std::string("the two-tap table of ibl/runtime/specular_models.hpp specular_lobe_taps (") +
                                                   bake_model::name + ", chain weight " + weight_name_ + ")",
                                               lut_->size, 8,
                                               "A, B, angle0 / acos(n.v), roughness0, weight0, angle1 / acos(n.v), roughness1, weight1",

@@ -1,6 +1,6 @@
 // tools/ibl-bake/stage_lookup.cpp — check: the specular chain where a renderer samples it. At
 // roughness 0.05, 0.1, ..., 1 (between the levels as well as on them), the lookup of
-// --specular-lookup (ibl/lookup.hpp) against the exact LD at that roughness, on the texel centres
+// --specular-lookup (ibl/runtime/lookup.hpp) against the exact LD at that roughness, on the texel centres
 // of a g x g-per-face cube (g = the quality's check grid) plus the 5 x 5 block about the brightest
 // direction: built-in sky: ibl::reference_ld_sky (sky by GGX IS, the sun's cap by quadrature);
 // files: ibl::reference_ld_texel_sum (every texel of a source level fine enough for the lobe).
@@ -17,10 +17,10 @@
 #include <cmath>
 #include <map>
 
-#include <ibl/integrate/lookup_error.hpp>
+#include <ibl/reference/lookup_error.hpp>
 #include <ibl/core/color.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 namespace ibl_bake {
 

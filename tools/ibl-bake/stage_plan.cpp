@@ -12,7 +12,7 @@
 
 #include <algorithm>
 
-#include <ibl/integrate/prefilter.hpp>
+#include <ibl/bake/prefilter.hpp>
 
 #include "scene_reader.hpp"
 

@@ -22,11 +22,11 @@
 #include <limits>
 
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/lookup_error.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/lookup_error.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/brdf/charlie.hpp>
-#include <ibl/integrate/sheen.hpp>
+#include <ibl/bake/sheen.hpp>
 
 #include "check_texels.hpp"
 

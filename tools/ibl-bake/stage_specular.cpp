@@ -14,9 +14,9 @@
 #include <type_traits>
 
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/metrics.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/reference.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 #include "check_texels.hpp"
 #include "cube_layout.hpp"

@@ -1,6 +1,6 @@
 // tools/ibl-bake/stage_split_sum.cpp — check: what the baked products give through the runtime
 // model. The single-scattering ambient of shade.hpp from the baked products (the chain read by
-// ibl/lookup.hpp's lookups; with --runtime lobe at the lobe LUT's direction and roughness with its
+// ibl/runtime/lookup.hpp's lookups; with --runtime lobe at the lobe LUT's direction and roughness with its
 // (A, B), with --runtime taps2 at the two taps' directions and roughness with the table's (A, B),
 // else at R and r with the DFG table's) and the diffuse product, plus an extracted sun as a
 // disk light, against ibl::reference_radiance (MIS of the BRDF and the source's luminance
@@ -19,8 +19,8 @@
 #include <cmath>
 
 #include <ibl/core/color.hpp>
-#include <ibl/integrate/env_importance.hpp>
-#include <ibl/integrate/radiance_reference.hpp>
+#include <ibl/reference/env_importance.hpp>
+#include <ibl/reference/radiance.hpp>
 
 namespace ibl_bake {
 

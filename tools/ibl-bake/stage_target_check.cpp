@@ -3,7 +3,7 @@
 // met or missed (stdout, report.json "target_check"); a miss is a warning, or with --strict an
 // error (pipeline.cpp: exit 1, nothing written).
 //
-// The targets (docs/scene-format.md, include/ibl/plan.hpp), at the shading points of
+// The targets (docs/scene-format.md, include/ibl/bake/plan.hpp), at the shading points of
 // --compare-full (the scene's materials at the ends and middle of each roughness range, 54 normals
 // seen at 45 degrees, scene_shading_points):
 //   specular  error_target: relative RMS of ambient luminance, the planned chain and DFG table
@@ -34,9 +34,9 @@
 #include <ibl/core/color.hpp>
 #include <ibl/core/frame.hpp>
 #include <ibl/env/cube_geometry.hpp>
-#include <ibl/integrate/dfg.hpp>
-#include <ibl/integrate/prefilter.hpp>
-#include <ibl/integrate/sphere_convolve.hpp>
+#include <ibl/bake/dfg.hpp>
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/bake/sphere_convolve.hpp>
 
 namespace ibl_bake {
 

@@ -28,10 +28,10 @@
 #include <vector>
 
 #include <ibl/brdf/model.hpp>
-#include <ibl/integrate/ld_weight.hpp>
-#include <ibl/integrate/roughness_mip.hpp>
-#include <ibl/lookup.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/runtime/ld_weight.hpp>
+#include <ibl/runtime/roughness_mip.hpp>
+#include <ibl/runtime/lookup.hpp>
+#include <ibl/runtime/shade.hpp>
 
 #include "ktx2.hpp"
 #include "pipeline.hpp"
@@ -67,10 +67,10 @@ inline double ms_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
 
-/// The products as a renderer samples them (ibl/lookup.hpp): the chain by the lookup `specular`
+/// The products as a renderer samples them (ibl/runtime/lookup.hpp): the chain by the lookup `specular`
 /// (its taps over the virtual chain, minus the first stored level, clamped to the stored levels),
 /// the DFG table by ibl::dfg_lookup in its layout (or dfg_exact when there is none), the diffuse
-/// product. The runtime model is the two-tap model when `taps` is set (ibl/runtime.hpp,
+/// product. The runtime model is the two-tap model when `taps` is set (ibl/runtime/specular_models.hpp,
 /// specular_lobe_taps: LD = sum_k w_k LD(cos(a_k) n + sin(a_k) t, r_k) / sum_k w_k, t the tangent
 /// of n towards R, (A, B) and the taps from one bilinear read of the table), the lobe LUT's when
 /// `lobe` is set (specular_lobe: LD at normalize(lerp(n, R, s)) and r_eff, (A, B) from the lobe

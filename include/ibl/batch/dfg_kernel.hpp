@@ -6,7 +6,7 @@
 // per row, or once per table); per texel only the mu-dependent quantities are formed. The loops
 // over lanes are branch-free (ternary selects inside the models' functions and here, no early
 // exits), so that g++/clang -O3 auto-vectorise them (sqrt needs -fno-math-errno to vectorise in
-// g++: the release preset sets it). The scalar entry points in integrate/dfg.hpp call the same
+// g++: the release preset sets it). The scalar entry points in bake/dfg.hpp call the same
 // templates with W = 1, so scalar and batch results are the same arithmetic lane by lane.
 //
 // Geometry (tangent space, z = n): v = (sqrt(1 - mu^2), 0, mu) lies in the xz-plane, so for a half
@@ -93,7 +93,7 @@ IBL_FUNC_VOID void dfg_mc_lanes(const T* hx, const T* hz, std::uint32_t n, T rou
 inline constexpr double dfg_quadrature_y_max = 40.0;
 
 /// The node tables of the DFG quadrature in normalised panel coordinates (independent of mu and
-/// roughness; see integrate/dfg.hpp for the derivation). Pointers into arrays owned elsewhere.
+/// roughness; see bake/dfg.hpp for the derivation). Pointers into arrays owned elsewhere.
 struct dfg_quadrature_view {
     const double* full_x;      ///< full-circle panel: Gauss-Legendre nodes in [0, 1] (y = y1 x)
     const double* full_w;      ///<   their weights (sum 1)

@@ -1,6 +1,6 @@
 #pragma once
 // ibl/batch/sphere_kernel.hpp — the structure-of-arrays kernel of the cubemap spherical convolution
-// (the fast path of integrate/sphere_convolve.hpp, which the prefilter and the irradiance
+// (the fast path of bake/sphere_convolve.hpp, which the prefilter and the irradiance
 // convolution use; host only). The integrator builds the tables; this header runs them over texels.
 //
 //   out[k] = factor * sum_i w_i B(src, level_i, F(dir_k) l_i)

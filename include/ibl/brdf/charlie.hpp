@@ -16,7 +16,7 @@
 //   V(v, l) = 1 / (4 (n.l + n.v - n.l n.v))                            [Neubelt-Pettineo 2013]
 //   written as 1 / (4 (n.l + n.v (1 - n.l))): a sum of non-negative terms (no cancellation). It is
 //   not derived from a masking function, so the sheen albedo it gives is not bounded by 1 near
-//   grazing view (integrate/sheen.hpp).
+//   grazing view (bake/sheen.hpp).
 //
 // Limits (the stability contract).
 //   r -> 0: the lobe concentrates on the great circle theta_h = pi/2 (its peak value

@@ -1,6 +1,6 @@
 #pragma once
 // ibl/core/gauss_legendre.hpp — Gauss-Legendre nodes and weights on [0, 1] (host only); used by
-// the DFG quadrature (integrate/) and the SH quadrature projection (sh/).
+// the DFG quadrature (bake/dfg.hpp) and the SH quadrature projection (sh/).
 //
 // The n nodes are the roots of the Legendre polynomial P_n (on [-1, 1], or mapped to [0, 1] with
 // weights summing to 1, so that sum_k w_k f(x_k) approximates the MEAN of f over [0, 1]); exact for

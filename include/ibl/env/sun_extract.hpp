@@ -5,8 +5,8 @@
 // Why. A sun carries most of a clear sky's irradiance in ~1e-3 sr. Baked into the environment
 // it defeats the cheap diffuse products (3-band SH: 54% mean error on ibl::make_default_sky) and
 // needs many specular samples. Split off, the residual environment is smooth (SH holds it) and
-// the sun is shaded as an analytic disk light (shade.hpp: disk_light_irradiance, shade_disk;
-// integrate/disk_light.hpp: its exact LD contribution to the prefiltered chain).
+// the sun is shaded as an analytic disk light (runtime/shade.hpp: disk_light_irradiance, shade_disk;
+// reference/disk_light.hpp: its exact LD contribution to the prefiltered chain).
 //
 // Rule (level 0 of the cubemap, luminance Y = 0.2126 R + 0.7152 G + 0.0722 B):
 //  1. threshold = max(threshold_over_median * median(Y), threshold_over_peak * peak(Y)), the
@@ -92,7 +92,7 @@ enum class sun_status : int {
 }
 
 /// The extracted light and the statistics of the decision (see the header for the definitions).
-/// direction, solid_angle and radiance are the disk light (shade.hpp's disk_light<T>).
+/// direction, solid_angle and radiance are the disk light (runtime/shade.hpp's disk_light<T>).
 template <class T> struct sun_extraction {
     sun_status status = sun_status::no_bright_region;
     vec3<T> direction{T(0), T(1), T(0)}; ///< unit, towards the light (power-weighted centroid)

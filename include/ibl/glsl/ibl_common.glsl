@@ -1,5 +1,5 @@
 // ibl/glsl/ibl_common.glsl — conventions and helpers shared by the GLSL mirror of the library's
-// runtime (ibl/lookup.hpp, ibl/shade.hpp, ibl/sh/convolve.hpp). Valid as GLSL ES 3.00 (WebGL2)
+// runtime (ibl/runtime/lookup.hpp, ibl/runtime/shade.hpp, ibl/sh/convolve.hpp). Valid as GLSL ES 3.00 (WebGL2)
 // and GLSL 4.50; no #version line: the including shader writes it (and, in ES, the precision
 // statements: `precision highp float; precision highp int; precision highp samplerCube;`, and
 // `precision highp sampler3D;` where a shader declares the occlusion table's sampler).
@@ -33,7 +33,7 @@
 //           column 0 the smallest n.v. Axis maps per the table's layout (ibl_dfg_layout):
 //           the bake's default puts texel centres at n.v = (i/(N-1))^3, r = (j/(N-1))^2
 //           (cbrt(n.v) x sqrt(r), edge aligned). Clamp to edge, bilinear.
-// Lobe LUT  the lobe model of ibl/runtime.hpp (ibl-bake --runtime lobe, its default): an N x N
+// Lobe LUT  the lobe model of ibl/runtime/specular_models.hpp (ibl-bake --runtime lobe, its default): an N x N
 //           RGBA table in the DFG table's layout and orientation (row 0 = the smallest
 //           roughness), R = A, G = B, B = s (the lerp factor of the lookup direction
 //           normalize(lerp(n, R, s))), A = r_eff (the chain roughness to read there); specular =
@@ -44,14 +44,14 @@
 //           acos(n.v)), G = r_B, B = A = 0; specular = F0 A LD(normalize(lerp(n, R, s)), r_eff) +
 //           F90 B LD(cos(a) n + sin(a) t, r_B), a = min(f_B acos(n.v), pi/2), t the tangent of n
 //           towards R (ibl_runtime.glsl ibl_specular_lobe_pair). Clamp to edge, bilinear (RGBA32F).
-// Taps LUT  the two-tap fitted model of ibl/runtime.hpp (specular_lobe_taps; lobe_fit.hpp's
+// Taps LUT  the two-tap fitted model of ibl/runtime/specular_models.hpp (specular_lobe_taps; lobe_fit.hpp's
 //           make_lobe_taps_lut with taps = 2): its eight channels per texel, in the DFG table's
 //           layout and orientation, as two RGBA textures of the same size: taps_a = channels
 //           0..3 (R = A, G = B, B = angle0 / acos(n.v), A = roughness0), taps_b = channels 4..7
 //           (R = weight0, G = angle1 / acos(n.v), B = roughness1, A = weight1); tap k reads the
 //           chain at cos(angle_k) n + sin(angle_k) t (t: the tangent of n towards R) and roughness_k.
 //           Clamp to edge, bilinear (RGBA32F: the table's floats).
-// SO LUT    the specular-occlusion table of ibl/occlusion.hpp (specular_occlusion_lut, size^3
+// SO LUT    the specular-occlusion table of ibl/runtime/specular_occlusion.hpp (specular_occlusion_lut, size^3
 //           floats at index (k size + j) size + i) as a size^3 3-D texture, one channel (R32F;
 //           R16F where OES_texture_float_linear is missing), uploaded as stored: texImage3D's x =
 //           i = n.v, y = j = r, z = k = ao (layer k = the k-th size^2 slice), texel (i, j, k) at

@@ -1,8 +1,8 @@
 // ibl/glsl/ibl_lookup.glsl — the runtime lookups of the baked products (GLSL mirror of
-// ibl/lookup.hpp and integrate/roughness_mip.hpp): the prefiltered specular chain at any
+// ibl/runtime/lookup.hpp and runtime/roughness_mip.hpp): the prefiltered specular chain at any
 // roughness (level taps + blend; the default log-geometric two-level blend and the textbook
 // textureLod), the DFG table at any (n.v, r) in its layout (dfg_lut_coord), and the lobe LUT of
-// ibl/runtime.hpp (lobe_lut_lookup, lerp_direction) read in the same layout. Needs
+// ibl/runtime/specular_models.hpp (lobe_lut_lookup, lerp_direction) read in the same layout. Needs
 // ibl_common.glsl first (conventions there).
 
 #ifndef IBL_GLSL_LOOKUP
@@ -209,7 +209,7 @@ vec3 ibl_dfg_lookup(sampler2D lut, float n_dot_v, float roughness, ibl_dfg_layou
     return textureLod(lut, ibl_dfg_lut_coord(n_dot_v, roughness, textureSize(lut, 0).x, lay), 0.0).rgb;
 }
 
-// ---- the lobe LUT (ibl/runtime.hpp: the one-tap lobe model) ----------------------------------------
+// ---- the lobe LUT (ibl/runtime/specular_models.hpp: the one-tap lobe model) ----------------------------------------
 
 // normalize(lerp(n, r_dir, s)) for unit n, r_dir, s clamped to [0, 1]; n where the lerp vanishes
 // (lerp_direction).

@@ -1,11 +1,11 @@
 // ibl/glsl/ibl_runtime.glsl — the runtime variants of the specular term (GLSL mirror of
-// ibl/runtime.hpp, with the pieces of core/frame.hpp, sampling/sequence.hpp and
+// ibl/runtime/specular_models.hpp, with the pieces of core/frame.hpp, sampling/sequence.hpp and
 // sampling/ggx.hpp they use): Frostbite's dominant direction, horizon fading and Lagarde's
-// specular occlusion; the specular-occlusion table of ibl/occlusion.hpp (a 3-D texture,
+// specular occlusion; the specular-occlusion table of ibl/runtime/specular_occlusion.hpp (a 3-D texture,
 // ibl_common.glsl) read about n or about a bent normal; runtime filtered importance sampling of
 // the chain (K taps along the GGX visible-normal lobe, each read at its footprint's roughness);
-// the fitted-taps model of integrate/lobe_fit.hpp in its two-tap form (two RGBA tables,
-// ibl_common.glsl); the two-part lobe model (the lobe LUT plus the B part's kernel table). The formulas and their derivations are in runtime.hpp's and occlusion.hpp's
+// the fitted-taps model of bake/lobe_fit.hpp in its two-tap form (two RGBA tables,
+// ibl_common.glsl); the two-part lobe model (the lobe LUT plus the B part's kernel table). The formulas and their derivations are in runtime/specular_models.hpp's and runtime/specular_occlusion.hpp's
 // headers; every function here is the same expression in the same order. Needs
 // ibl_common.glsl, ibl_lookup.glsl and ibl_shade.glsl first.
 //
@@ -56,7 +56,7 @@ float ibl_specular_occlusion_lagarde(float n_dot_v, float ambient_occlusion, flo
     return ibl_saturate(pow(ibl_saturate(n_dot_v) + ao, exp2(-16.0 * a - 1.0)) - 1.0 + ao);
 }
 
-// ---- specular occlusion table (ibl/occlusion.hpp) ------------------------------------------------
+// ---- specular occlusion table (ibl/runtime/specular_occlusion.hpp) ------------------------------------------------
 
 // Sampler coordinate of (n.v, r, ao) in a size^3 edge-aligned table (ibl_common.glsl, SO LUT):
 // (x (size - 1) + 0.5) / size per axis, inputs clamped to [0, 1]; with clamp-to-edge and linear
@@ -225,7 +225,7 @@ struct ibl_runtime_tap {
 };
 
 // Tap k of `count` along the GGX lobe of roughness r seen from v_local (tangent space of fr,
-// v_local.z = n.v >= 0), Schlick F(F0, F90); footprint_scale = c of runtime.hpp (fis_tap).
+// v_local.z = n.v >= 0), Schlick F(F0, F90); footprint_scale = c of runtime/specular_models.hpp (fis_tap).
 ibl_runtime_tap ibl_fis_tap(ibl_frame fr, vec3 v_local, float roughness, uint k, uint count, float footprint_scale,
                             vec3 f0, vec3 f90) {
     ibl_runtime_tap t = ibl_runtime_tap(vec3(0.0, 0.0, 1.0), vec3(0.0), 0.0);
@@ -281,7 +281,7 @@ vec3 ibl_specular_fis(samplerCube chain, ibl_specular_desc d, int taps, float fo
     return ibl_fis_combine(sum, wsum, count, normalise, albedo, fb);
 }
 
-// ---- fitted taps (integrate/lobe_fit.hpp, two taps) -------------------------------------------------
+// ---- fitted taps (bake/lobe_fit.hpp, two taps) -------------------------------------------------
 
 // The unit tangent of n in the plane of incidence, towards R; make_frame(n).t when R is (nearly)
 // n (incidence_tangent).
@@ -335,7 +335,7 @@ vec3 ibl_specular_lobe_taps2(samplerCube chain, ibl_specular_desc sd, sampler2D 
     return ibl_specular_ibl(s.ld, f0, f90, s.dfg);
 }
 
-// ---- the two-part lobe model (runtime.hpp specular_lobe_pair; ibl-bake --runtime lobe) ---------
+// ---- the two-part lobe model (runtime/specular_models.hpp specular_lobe_pair; ibl-bake --runtime lobe) ---------
 
 // The effective LD (F0 A LD_a + F90 B LD_b) / (F0 A + F90 B) per channel (LD_a where that albedo
 // is 0): LD (F0 A + F90 B) of it, e.g. ibl_ambient, is the two-part model (lobe_pair_ld).

@@ -1,9 +1,9 @@
 // ibl/glsl/ibl_shade.glsl — the runtime combination of the products (GLSL mirror of
-// ibl/shade.hpp): material terms (metallic workflow), the single-scattering ambient (Karis 2013,
+// ibl/runtime/shade.hpp): material terms (metallic workflow), the single-scattering ambient (Karis 2013,
 // kD = (1 - F_roughness)(1 - metallic)), the multiple-scattering ambient (Fdez-Aguera 2019:
 // FssEss LD + (FmsEms + diffuse_albedo Edss) E/pi), direct Cook-Torrance lights (directional,
 // point) and disk lights (a sun: exact cap irradiance, widened-lobe specular). The formulas and
-// their derivations are in shade.hpp's header; every function here is the same expression in the
+// their derivations are in runtime/shade.hpp's header; every function here is the same expression in the
 // same order. Needs ibl_common.glsl first;
 // ibl_lookup_sample, ibl_lobe_sample and ibl_specular_lobe additionally need ibl_lookup.glsl
 // before this file.
@@ -163,7 +163,7 @@ ibl_sample ibl_lookup_sample(samplerCube chain, ibl_specular_desc sd, sampler2D 
     return ibl_sample(ibl_specular_lookup(chain, r_dir, roughness, sd), irradiance_over_pi, dfg.xy);
 }
 
-// The products at a shading point through the lobe LUT (ibl/runtime.hpp specular_lobe): with
+// The products at a shading point through the lobe LUT (ibl/runtime/specular_models.hpp specular_lobe): with
 // (A, B, s, r_eff) = ibl_lobe_lut_lookup(lobe_lut, n.v, r), LD at normalize(lerp(n, R, s)) and
 // r_eff, (A, B) as the sample's dfg; E/pi passed through. ibl_ambient on it is the lobe model.
 ibl_sample ibl_lobe_sample(samplerCube chain, ibl_specular_desc sd, sampler2D lobe_lut, ibl_dfg_layout lay, vec3 n,
@@ -269,7 +269,7 @@ vec3 ibl_shade_point(vec3 p, vec3 n, vec3 v, vec3 position, vec3 intensity, ibl_
     return ibl_shade_light(n, v, l, intensity * (1.0 / max(d2, 1e-4)), m);
 }
 
-// ---- disk lights (a sun: a uniform spherical cap; shade.hpp's "Disk lights" section) ---------------
+// ---- disk lights (a sun: a uniform spherical cap; runtime/shade.hpp's "Disk lights" section) ---------------
 
 // A distant uniform disk: unit direction TOWARDS its centre, solid angle Omega = 2 pi (1 - cos r)
 // in [0, 2 pi] sr, radiance L (lights.json of ibl-bake: "direction", "solid_angle", "radiance").

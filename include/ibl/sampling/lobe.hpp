@@ -1,6 +1,6 @@
 #pragma once
-// ibl/sampling/lobe.hpp — the *lobe* concept that the prefilter (integrate/prefilter.hpp) and the
-// LD reference (integrate/reference.hpp) are templated on, and the two lobes the library ships:
+// ibl/sampling/lobe.hpp — the *lobe* concept that the prefilter (bake/prefilter.hpp) and the
+// LD reference (reference/ld_irradiance.hpp) are templated on, and the two lobes the library ships:
 // GGX (the default everywhere) and Charlie (sheen).
 //
 // A lobe is the half-vector distribution of a split-sum LD term. With N = V = R the LD kernel is
@@ -99,7 +99,7 @@ struct ggx_lobe {
 };
 
 /// The clamped-cosine lobe about N (= R in the prefilter's frame): the diffuse kernel, so that the
-/// lobe-generic prefilter is also an irradiance integrator (integrate/irradiance.hpp
+/// lobe-generic prefilter is also an irradiance integrator (bake/irradiance.hpp
 /// irradiance_cubemap_lobe: E = pi x the lobe's normalised mean). l is drawn with density
 /// cos(theta_l) / pi (sample_cosine_hemisphere), h = normalize(l + n); ld_weight cancels the
 /// estimator's n.l factor (weight 1 per draw); roughness is unused. A user-defined diffuse lobe

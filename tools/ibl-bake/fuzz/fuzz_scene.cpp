@@ -13,7 +13,7 @@
 #include <stdexcept>
 #include <string>
 
-#include <ibl/plan.hpp>
+#include <ibl/bake/plan.hpp>
 
 #include "scene_reader.hpp"
 

@@ -32,14 +32,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <ibl/integrate/dfg_lut.hpp>
-#include <ibl/integrate/disk_light.hpp>
-#include <ibl/integrate/lobe_fit.hpp>
-#include <ibl/integrate/lobe_lut.hpp>
-#include <ibl/lookup.hpp>
-#include <ibl/runtime.hpp>
+#include <ibl/bake/dfg_lut.hpp>
+#include <ibl/reference/disk_light.hpp>
+#include <ibl/bake/lobe_fit.hpp>
+#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/runtime/lookup.hpp>
+#include <ibl/runtime/specular_models.hpp>
 #include <ibl/sh/convolve.hpp>
-#include <ibl/shade.hpp>
+#include <ibl/runtime/shade.hpp>
 
 namespace fs = std::filesystem;
 using namespace ibl_bake;

@@ -1,12 +1,12 @@
 #pragma once
-// ibl/lookup.hpp — the runtime lookups of the baked products, as a renderer performs them: the
+// ibl/runtime/lookup.hpp — the runtime lookups of the baked products, as a renderer performs them: the
 // prefiltered specular chain at any roughness, the DFG table at any (n.v, roughness). Shader code
-// mirrors these functions; integrate/lookup_error.hpp measures them against the exact LD and DFG
+// mirrors these functions; reference/lookup_error.hpp measures them against the exact LD and DFG
 // (docs/lookup.md has the measurements and the derivation of the defaults).
 //
 // ---- Specular: which levels, which weights ---------------------------------------------------
 // A chain of L levels (m = L - 1) holds at level l the roughness r_l = roughness_from_lod(mapping,
-// l, m) (integrate/roughness_mip.hpp: the bake's policy). A lookup at roughness r finds the
+// l, m) (runtime/roughness_mip.hpp: the bake's policy). A lookup at roughness r finds the
 // bracketing levels l <= lod(r) < l + 1 (lod(r) = lod_from_roughness(mapping, r, m), l clamped to
 // [0, m - 1]) and a fraction t in [0, 1] by one of
 //   level_weight::lod     t = lod(r) - l                     (the textbook lookup: textureLod at
@@ -37,13 +37,13 @@
 // reproduce a constant environment exactly (the weights sum to 1).
 //
 // ---- DFG ----------------------------------------------------------------------------------------
-// The table's layout (integrate/dfg_layout.hpp) is part of the table: dfg_lookup reads it from the
+// The table's layout (runtime/dfg_layout.hpp) is part of the table: dfg_lookup reads it from the
 // table (member `layout`), so a table is never read in another layout than its own. The default
 // (textbook) layout is read by texture(lut, vec2(n.v, r)); dfg_lut_layout::remapped() tables by
 // texture(lut, dfg_lut_coord(n.v, r, N, layout)).
 //
 // ---- Shading -------------------------------------------------------------------------------------
-// ibl_lookup_sample() gathers an ibl_sample (shade.hpp) from a chain and a table at a shading
+// ibl_lookup_sample() gathers an ibl_sample (runtime/shade.hpp) from a chain and a table at a shading
 // point, so pbr_shader::ambient runs on exactly these lookups.
 //
 // Domains: roughness clamped to [0, 1] and n.v to [0, 1] (NaN -> 0). A chain of one level returns
@@ -51,7 +51,7 @@
 // Value functions (weights, coordinates) are IBL_FUNC; the lookups that read a cubemap<float> or a
 // table in host memory are host functions.
 
-#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
 #include <cmath>
@@ -60,11 +60,11 @@
 #include <stdexcept>
 #include <string>
 
-#include "core/math.hpp"
-#include "core/vec.hpp"
-#include "env/cubemap.hpp"
-#include "integrate/dfg_layout.hpp"
-#include "integrate/roughness_mip.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
+#include "../env/cubemap.hpp"
+#include "dfg_layout.hpp"
+#include "roughness_mip.hpp"
 #include "shade.hpp"
 
 namespace ibl {
@@ -209,7 +209,7 @@ IBL_FUNC vec3<T> specular_blend(const specular_taps<T>& s, const vec3<T>* values
 
 namespace detail {
 /// The description a chain is read with: d, with the chain's own mapping when the chain records
-/// one (integrate/chain.hpp's specular_chain).
+/// one (runtime/chain.hpp's specular_chain).
 template <class Chain> specular_lookup_desc chain_desc(const Chain& chain, specular_lookup_desc d) noexcept {
     if constexpr (requires { chain.mapping; }) d.mapping = chain.mapping;
     return d;
@@ -229,7 +229,7 @@ template <class Chain, class Table> void check_chain_weight(const char* fn, cons
 /// of specular_lookup_taps, each a seamless bilinear read of its level, summed; negative channels
 /// (Catmull-Rom) clamped to 0. A two-level lookup is computed as lerp(L_l, L_{l+1}, t), i.e.
 /// exactly the trilinear chain.radiance(dir, l + t) a GPU's textureLod gives. A specular_chain
-/// (what prefilter returns, integrate/chain.hpp) is read with its own mapping (d.mapping is
+/// (what prefilter returns, runtime/chain.hpp) is read with its own mapping (d.mapping is
 /// replaced by the chain's); a plain cubemap with d as given.
 template <class Chain>
     requires std::derived_from<Chain, cubemap<float>>

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/dfg_multiscatter.hpp — the directional albedo E(mu, r) of a microfacet model and
+// ibl/bake/dfg_multiscatter.hpp — the directional albedo E(mu, r) of a microfacet model and
 // the multiple-scattering energy compensation built on it (the optional third DFG LUT channel).
 //
 // Single scattering loses energy at high roughness: the albedo for F = 1,

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/irradiance.hpp — diffuse irradiance of an environment (host only).
+// ibl/bake/irradiance.hpp — diffuse irradiance of an environment (host only).
 //
 // Convention: the library's irradiance is E (W/m^2-like), not E / pi:
 //     E(n) = integral over the hemisphere around n of L(l) max(n.l, 0) dl
@@ -7,7 +7,7 @@
 // radiance rho E / pi (brdf/lambert.hpp: f = rho / pi). (LearnOpenGL's irradiance map stores
 // E / pi and its shader multiplies by albedo without the 1/pi; to match it divide these by pi.)
 //
-// Two estimators, each a sample table in tangent space (z = n) for integrate/sphere_convolve.hpp:
+// Two estimators, each a sample table in tangent space (z = n) for bake/sphere_convolve.hpp:
 //
 //  * riemann (the literature: LearnOpenGL's irradiance convolution). In spherical coordinates
 //        E = integral_0^{2 pi} integral_0^{pi/2} L cos(theta) sin(theta) dtheta dphi,
@@ -26,7 +26,7 @@
 //
 // Filtering (filtered = true): each node / sample reads the source lod whose texel solid angle
 // matches its share of the sphere times 4^lod_bias (Krivanek & Colbert 2008, as in
-// integrate/prefilter.hpp): the Riemann node's own solid angle sin(theta) dtheta dphi, or
+// bake/prefilter.hpp): the Riemann node's own solid angle sin(theta) dtheta dphi, or
 // 1 / (N pdf) = pi / (N cos theta) for cosine sampling. Without filtering every sample reads
 // level 0 (the literature). Output: irradiance_cubemap gives a one-level cubemap<float> of face
 // size `size` (32 by default: irradiance is smooth, its spectrum ends at SH band 2 to within 1%).
@@ -319,7 +319,7 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
     return out;
 }
 
-/// Irradiance through the lobe-generic prefilter (integrate/prefilter.hpp): a one-level cubemap of
+/// Irradiance through the lobe-generic prefilter (bake/prefilter.hpp): a one-level cubemap of
 /// face `size` holding pi times the normalised mean of the source over lobe L about each texel's
 /// direction, by `samples` draws of L (filtered importance sampling: each draw reads the source
 /// at the lod of its solid angle 1 / (N pdf_l), bias `lod_bias`). With the default cosine_lobe

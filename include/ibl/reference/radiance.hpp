@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/radiance_reference.hpp — outgoing radiance under an environment WITHOUT the
+// ibl/reference/radiance.hpp — outgoing radiance under an environment WITHOUT the
 // split-sum approximation: the reference that measures the split sum's error per material
 // (host only, double precision, deterministic; slow by design).
 //
@@ -13,11 +13,11 @@
 //                                  and its integral is k_d diffuse_albedo E(n) / pi:
 //       diffuse_weighting::lambert                       k_d = 1 (f = f_d + f_s, no coupling)
 //       diffuse_weighting::one_minus_fresnel_roughness   k_d = 1 - F_r(n.v), F_r = fresnel_schlick_
-//           roughness(n.v, F0, r): the kD of shade.hpp's single-scattering ambient
-//           ((1 - F)(1 - metallic) base_color), so that shade.hpp's diffuse term and this
+//           roughness(n.v, F0, r): the kD of runtime/shade.hpp's single-scattering ambient
+//           ((1 - F)(1 - metallic) base_color), so that runtime/shade.hpp's diffuse term and this
 //           reference's diffuse term are the same functional of L and the comparison measures the
 //           specular split-sum error (and the irradiance product's error) only.
-//   The reference is single scattering: it matches shade.hpp's single-scattering path, not the
+//   The reference is single scattering: it matches runtime/shade.hpp's single-scattering path, not the
 //   Fdez-Agüera multiple-scattering path (whose extra lobe has no BRDF to integrate).
 //   Mirror limit: when M::alpha(r) is ggx_effectively_smooth (r < 2^-6 for alpha = r^2), f_s is
 //   the delta of an ideal mirror and its term is exactly F(n.v) L(R), R = reflect(-v, n) = 2 (n.v)
@@ -43,7 +43,7 @@
 //       p_s = 0.
 //       For a model whose NDF is not GGX, the GGX VNDF of alpha = M::alpha(r) is still a valid
 //       proposal (its support is the whole upper hemisphere); only efficiency changes.
-//   (e) the environment: cube_env_distribution (integrate/env_importance.hpp): texels by luminance
+//   (e) the environment: cube_env_distribution (reference/env_importance.hpp): texels by luminance
 //       times solid angle, uniform in (sc, tc) within the texel, pdf_e per solid angle.
 //   Weights: the power heuristic (beta = 2) by default, balance optionally, with the counts:
 //       w_b(l) = (n_b pdf_b)^2 / ((n_b pdf_b)^2 + (n_e pdf_e)^2),   w_e = 1 - w_b,

@@ -1,6 +1,6 @@
 #pragma once
-// ibl/integrate/sphere_convolve.hpp — the machinery shared by the prefilter (integrate/prefilter.hpp)
-// and the irradiance convolution (integrate/irradiance.hpp): a spherical convolution of an
+// ibl/bake/sphere_convolve.hpp — the machinery shared by the prefilter (bake/prefilter.hpp)
+// and the irradiance convolution (bake/irradiance.hpp): a spherical convolution of an
 // environment with a kernel that is rotationally symmetric about the output direction, evaluated
 // from a sample table in tangent space (host only).
 //

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/dfg_fit.hpp — analytic approximations of the split-sum DFG terms, for comparison
+// ibl/runtime/dfg_fit.hpp — analytic approximations of the split-sum DFG terms, for comparison
 // with the exact table (their measured errors: bench/bench_dfg.cpp and the test suite).
 //
 // Karis' EnvBRDFApprox (B. Karis, "Physically Based Shading on Mobile", Unreal Engine blog, 2014),

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/env_importance.hpp — importance sampling of an environment by its luminance: a
+// ibl/reference/env_importance.hpp — importance sampling of an environment by its luminance: a
 // piecewise-constant distribution over the texels of a cubemap (host only: std::vector storage).
 //
 // Distribution. Texel i of the chosen level gets the weight

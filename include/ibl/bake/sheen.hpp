@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/sheen.hpp — the sheen products: the directional albedo of the Charlie sheen lobe by
+// ibl/bake/sheen.hpp — the sheen products: the directional albedo of the Charlie sheen lobe by
 // deterministic quadrature, as a look-up table in the DFG table's layout, and the Charlie-
 // prefiltered environment (host only).
 //
@@ -19,7 +19,7 @@
 // which removes V's near-singularity at n.l, n.v -> 0 (g(x) = x (1 + O(mu)): the Jacobian's
 // (n.l + mu) cancels V's denominator up to O(mu) terms). On a theta slice n.l = A cos(phi) + B,
 // A = 2 c s sin(theta_v), B = mu (c^2 - s^2), and the n.l = 0 boundary splits theta exactly as in
-// the DFG quadrature (integrate/dfg.hpp): tan(theta1) = mu / (1 + sin theta_v), theta2 = pi/2 -
+// the DFG quadrature (bake/dfg.hpp): tan(theta1) = mu / (1 + sin theta_v), theta2 = pi/2 -
 // theta1 (cos(theta2) = sin(theta1) ~ mu / 2 for small mu: exact, no cancellation). Then
 //   E = (k / pi) [ int_0^theta1 s^(1/alpha + 1) / (2 c) Phi(theta) d(theta)
 //                + int_{ln c2}^{ln c1} s^(1/alpha) / 2 Phi d(ln c) ],   Phi = int_0^{phi_max} g dphi,
@@ -43,7 +43,7 @@
 // size first); dfg_lut::sample(n.v, r).x is its bilinear lookup. Rows go through the executor;
 // the table does not depend on the partition.
 //
-// Prefiltered chain: prefilter<charlie_lobe>(env, opt) (integrate/prefilter.hpp with the lobe of
+// Prefiltered chain: prefilter<charlie_lobe>(env, opt) (bake/prefilter.hpp with the lobe of
 // sampling/lobe.hpp): level l holds the Charlie LD (N = V = R) for sheen roughness
 // opt.policy.roughness(l, levels); level 0 (r = 0) is the ring limit, convolved like the others.
 // prefilter_sheen(env, opt) is that call.

@@ -1,7 +1,7 @@
 #pragma once
-// ibl/integrate/lobe_fit.hpp — the specular lobe as a mixture of a few chain kernels (host only).
+// ibl/bake/lobe_fit.hpp — the specular lobe as a mixture of a few chain kernels (host only).
 //
-// A prefiltered chain of weight w (integrate/prefilter.hpp, N = V = R) read at direction d and
+// A prefiltered chain of weight w (bake/prefilter.hpp, N = V = R) read at direction d and
 // roughness r' returns the environment convolved with its normalised kernel, a function of
 // mu = d.l alone:
 //     K(mu; r') = D(h) w(mu) / (4 W(r')),  D(h) = a^2 / (pi (c^2 (a^2 - 1) + 1)^2),
@@ -18,7 +18,7 @@
 // matter, so the objective is estimated over the lobe's own visible-normal draws (a midpoint grid
 // of nodes^2 points, weights f (n.l) / pdf_l). A kernel that reaches below the horizon loses
 // that mass from the lobe's support, so the L1 fit trades width against leakage by itself; the
-// first-moment match of integrate/lobe_lut.hpp does not see the horizon at all.
+// first-moment match of bake/lobe_lut.hpp does not see the horizon at all.
 // The fit is a Nelder-Mead search from the moment solution, k taps from the fitted k - 1 with the
 // heaviest tap split in two; it is derived from the BRDF alone, nothing is fitted to an environment. Weights summing
 // to 1 keep the white furnace: a constant environment gives exactly (F0 A + F90 B) L.
@@ -43,6 +43,7 @@
 #include "../sampling/ggx.hpp"
 #include "lobe_lut.hpp"
 #include "prefilter.hpp"
+#include "../runtime/tables.hpp"
 
 namespace ibl {
 
@@ -109,7 +110,7 @@ struct lobe_tap {
 inline constexpr int lobe_max_taps = 8;
 
 /// The fitted mixture at (n.v, r): taps (count of them), its L1 distance to the lobe, and the L1
-/// distance of the one-tap moment match (integrate/lobe_lut.hpp) for comparison.
+/// distance of the one-tap moment match (bake/lobe_lut.hpp) for comparison.
 struct lobe_mixture {
     int count = 0;
     std::array<lobe_tap, lobe_max_taps> taps{};
@@ -409,25 +410,6 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     return out;
 }
 
-/// A table of fitted mixtures in a DFG layout (lookup.hpp): texel (i, j) at
-/// n.v = dfg_texel_value(layout.n_dot_v, i), r = dfg_texel_value(layout.roughness, j); channels
-/// 2 + 3 taps: A, B (make_dfg_lut_exact), then per tap (ascending angle) the angle from n towards
-/// R over the view angle acos(n.v) (1 = at R, 0 = at n; runtime.hpp's lobe_tap_angle), the
-/// roughness (or lod over levels - 1 for a fit of stored levels) and the weight. Relative angles
-/// interpolate between texels where absolute ones cannot: a narrow lobe sits at R, whose angle
-/// changes fast near n.v = 1 (a bilinear read of absolute angles missed it by 6 degrees there).
-/// The mirror row r = 0 holds one tap at R (1) of roughness 0.
-struct lobe_taps_lut {
-    std::uint32_t size = 0;
-    std::uint32_t channels = 0;
-    int taps = 0;
-    std::vector<float> data; ///< (j * size + i) * channels + c
-    ld_weight weight = ld_weight::n_dot_l;
-    dfg_lut_layout layout{};             ///< which (n.v, r) each texel holds (read by the lookups)
-    std::vector<double> level_roughness; ///< empty: taps hold roughness
-    double max_l1 = 0.0, mean_l1 = 0.0; ///< of the fits at the texels with r >= 0.05 and A + B > 0
-};
-
 /// Fits every texel (header; rows in parallel) by fit_specular_lobe. size in [1, 256].
 template <class Model = ggx_height_correlated, class Executor = thread_executor>
 lobe_taps_lut make_lobe_taps_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, const lobe_fit_options& o = {},
@@ -509,7 +491,7 @@ inline lobe_lut lobe_lut_from_one_tap(const lobe_taps_lut& t) {
 }
 } // namespace detail
 
-/// The one-tap fit as a lobe LUT (A, B, s, r_eff) for ibl::specular_lobe (runtime.hpp): s the
+/// The one-tap fit as a lobe LUT (A, B, s, r_eff) for ibl::specular_lobe (runtime/specular_models.hpp): s the
 /// lerp factor whose normalize(lerp(n, R, s)) is at the fitted angle (clamped to [0, 1]: between
 /// n and R). Same layout and argument rules as make_lobe_taps_lut (o.taps is ignored: 1;
 /// level_roughness must be empty).
@@ -520,24 +502,6 @@ lobe_lut make_lobe_lut_fitted(std::uint32_t size, const dfg_lut_layout& layout, 
     o.level_roughness.clear();
     return detail::lobe_lut_from_one_tap(make_lobe_taps_lut<Model>(size, layout, w, o, ex));
 }
-
-/// The two-part lobe model's tables (ibl::specular_lobe_pair, runtime.hpp). The specular lobe
-/// with Schlick's Fresnel is F0 times its A part (weight 1 - (1 - v.h)^5) plus F90 times its B
-/// part (weight (1 - v.h)^5). The B part has another shape and direction (it leans beyond R
-/// towards grazing reflection: at n.v = 0.9, r = 0.5 its fitted kernel sits 2.7 view angles from
-/// n, and the whole lobe's kernel is at L1 distance 1.5 of it, 2 being disjoint), and a
-/// dielectric's specular is mostly B; the A part is the whole lobe but for a small grazing
-/// share (the whole lobe's kernel is within 0.013 in L1 of the A part's own fit).
-///   a: (A, B, s, r_eff)  make_lobe_lut_fitted's table (the whole lobe's kernel, read for the A
-///                        part; the same file a one-kernel consumer reads);
-///   b: (f_B, r_B, 0, 0)  the B part's kernel (o.part = b): its angle from n towards R over the
-///                        view angle acos(n.v) (as the fitted taps' angles: runtime.hpp
-///                        lobe_tap_angle; the B kernel may lie beyond R, which no lerp factor in
-///                        [0, 1] reaches) and its chain roughness. The mirror row: at R, 0.
-/// Both in the same DFG layout and size; o.taps is ignored (1), o.part is set per table.
-struct lobe_pair_lut {
-    lobe_lut a, b;
-};
 
 template <class Model = ggx_height_correlated, class Executor = thread_executor>
 lobe_pair_lut make_lobe_pair_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, lobe_fit_options o = {},

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/lobe_lut.hpp — the lobe LUT of ibl/runtime.hpp: per (n.v, r) the DFG terms A, B
+// ibl/bake/lobe_lut.hpp — the lobe LUT of ibl/runtime/specular_models.hpp: per (n.v, r) the DFG terms A, B
 // and the lobe's dominant-direction lerp factor s and matched chain roughness r_eff (host only).
 //
 // Moments of the specular lobe (Fresnel excluded). In the tangent frame of n with
@@ -15,7 +15,7 @@
 //          lobe_min_theta (at n.v = 1 every s gives n; the floor keeps s continuous there)
 //   var_major, var_minor  second moments of p in the tangent plane of m / rho, in and across the
 //          plane of incidence (the lobe's stretch; reported, not stored)
-// The LD kernel of a chain (integrate/prefilter.hpp, N = V = R): weight k(R.l) = R.l (Karis) or
+// The LD kernel of a chain (bake/prefilter.hpp, N = V = R): weight k(R.l) = R.l (Karis) or
 // G1(R.l), density D(h) over l. Its mean resultant length is
 //   rho_LD(alpha) = int k(mu) mu D dl / int k(mu) D dl,  mu = R.l = 2 cos^2 theta_h - 1,
 // integrated over the GGX NDF variable u (cos^2 theta_h = (1 - u) / (1 + (alpha^2 - 1) u), the
@@ -39,10 +39,11 @@
 #include "../core/limits.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
-#include "../lookup.hpp"
+#include "../runtime/lookup.hpp"
 #include "../sampling/ggx.hpp"
 #include "dfg_lut.hpp"
 #include "prefilter.hpp"
+#include "../runtime/tables.hpp"
 
 namespace ibl {
 
@@ -152,18 +153,8 @@ inline double ld_matched_roughness(double rho, ld_weight w, std::uint32_t kernel
     return 0.5 * (lo + hi);
 }
 
-/// A four-channel table (A, B, s, r_eff) in a DFG layout (lookup.hpp): texel (i, j) at
-/// n.v = dfg_texel_value(layout.n_dot_v, i), r = dfg_texel_value(layout.roughness, j).
-struct lobe_lut {
-    std::uint32_t size = 0;
-    std::uint32_t channels = 4;
-    std::vector<float> data; ///< (j * size + i) * 4 + c
-    ld_weight weight = ld_weight::n_dot_l; ///< the chain kernel r_eff was matched to
-    dfg_lut_layout layout{};               ///< which (n.v, r) each texel holds (read by the lookups)
-};
-
 /// The lobe LUT of model M for a chain baked with weight w (header). A, B from
-/// make_dfg_lut_exact (integrate/dfg_lut.hpp) in the same layout. size in [1, 1024].
+/// make_dfg_lut_exact (bake/dfg_lut.hpp) in the same layout. size in [1, 1024].
 template <class Model = ggx_height_correlated, class Executor = thread_executor>
 lobe_lut make_lobe_lut(std::uint32_t size, const dfg_lut_layout& layout, ld_weight w, std::uint32_t nodes = 96,
                        Executor&& ex = Executor{}) {

@@ -1,12 +1,12 @@
 #pragma once
-// ibl/integrate/dfg.hpp — the split-sum DFG terms (A, B) of a BRDF model: Monte Carlo (GGX-NDF and
+// ibl/bake/dfg.hpp — the split-sum DFG terms (A, B) of a BRDF model: Monte Carlo (GGX-NDF and
 // visible-normal sampling) and a deterministic quadrature that converges to 1e-6 and beyond.
 //
 // The quantity (Karis 2013, "Real Shading in Unreal Engine 4"). For a model M (brdf/model.hpp)
 // with specular lobe f = D V F and Schlick Fresnel F = F0 (1 - Fc) + F90 Fc, Fc = (1 - v.h)^5:
 //   int f(v, l) (n.l) d(omega_l) = F0 A + F90 B,
 //   A = int D V (n.l) (1 - Fc) d(omega_l),   B = int D V (n.l) Fc d(omega_l),
-// and E = A + B is the directional albedo for F = 1 (used by integrate/dfg_multiscatter.hpp).
+// and E = A + B is the directional albedo for F = 1 (used by bake/dfg_multiscatter.hpp).
 // v = (sqrt(1 - mu^2), 0, mu) in tangent space, mu = n.v; r = perceptual roughness.
 //
 // Half-vector form. With d(omega_l) = 4 (v.h) d(omega_h) and h parameterised by the GGX NDF's CDF

@@ -1,6 +1,6 @@
 #pragma once
-// ibl/integrate/lookup_error.hpp — what a renderer gets: the error of the runtime lookups of
-// ibl/lookup.hpp at any roughness and n.v, against exact references (host only), plus the tables
+// ibl/reference/lookup_error.hpp — what a renderer gets: the error of the runtime lookups of
+// ibl/runtime/lookup.hpp at any roughness and n.v, against exact references (host only), plus the tables
 // of the non-uniform DFG layouts and the storage-format rounding.
 //
 // Specular (specular_lookup_error). For each roughness r of a list and each direction of a set,
@@ -15,7 +15,7 @@
 //   levels         the lookup of the chain against sum_k w_k ref(dir, r_k): the levels' own
 //                  error (prefilter noise and bias, bilinear reconstruction, storage rounding)
 //                  seen through the same weights; 0 at r = r_k for an exact level.
-// Metrics are integrate/metrics.hpp's over the scalar Y per direction; the relative ones use a
+// Metrics are reference/metrics.hpp's over the scalar Y per direction; the relative ones use a
 // floor of floor_rel x the mean reference luminance over the directions at that roughness (the
 // tool's convention), so that dark directions are judged against the environment's brightness.
 //
@@ -28,7 +28,7 @@
 //   LD(R) = sum_t L_t w_t / sum_t w_t,   w_t = Omega_t D(n.h_t) max(c_t, 0),  c_t = R . d_t,
 // with n = v = R, so n.h = |R + d| / 2 and n.h^2 = (1 + c)/2: D depends on the texel only through
 // c. Dividing by the weights' sum (not the closed-form normaliser) makes a constant environment
-// exact. The LD weight of the chain under test (integrate/ld_weight.hpp) is a parameter:
+// exact. The LD weight of the chain under test (runtime/ld_weight.hpp) is a parameter:
 // ld_weight::g1 multiplies each texel's weight by G1(c_t) / c_t (w_t = Omega_t D G1(c_t)), as
 // the prefilter's G1 samples are weighted. The midpoint rule is accurate when the lobe spans several texels: the lobe of l has an
 // angular half-width of about 2 alpha, and reference_ld_texel_level picks the coarsest level
@@ -66,13 +66,13 @@
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
 #include "../env/cubemap.hpp"
-#include "../lookup.hpp"
+#include "../runtime/lookup.hpp"
 #include "../sampling/lobe.hpp"
-#include "dfg.hpp"
-#include "dfg_lut.hpp"
-#include "ld_weight.hpp"
+#include "../bake/dfg.hpp"
+#include "../bake/dfg_lut.hpp"
+#include "../runtime/ld_weight.hpp"
 #include "metrics.hpp"
-#include "roughness_mip.hpp"
+#include "../runtime/roughness_mip.hpp"
 
 namespace ibl {
 

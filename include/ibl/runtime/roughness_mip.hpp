@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/roughness_mip.hpp — the roughness <-> mip level policy of a prefiltered chain.
+// ibl/runtime/roughness_mip.hpp — the roughness <-> mip level policy of a prefiltered chain.
 //
 // A prefiltered environment stores the split-sum LD term for one perceptual roughness r per mip
 // level. Which r a level holds is an explicit, invertible policy; a renderer that samples the

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/dfg_layout.hpp — how a table indexed by (n.v, roughness) lays out its texels (the
+// ibl/runtime/dfg_layout.hpp — how a table indexed by (n.v, roughness) lays out its texels (the
 // DFG table, the lobe LUT, the fitted-taps table), and the one bilinear read of such a table.
 // Every table struct records its layout (member `layout`); the lookups read it from the table,
 // so a table cannot be read in another layout than the one it was built in.

@@ -1,5 +1,5 @@
 #pragma once
-// ibl/shade.hpp — the runtime combination of the baked products: ambient (image-based) diffuse
+// ibl/runtime/shade.hpp — the runtime combination of the baked products: ambient (image-based) diffuse
 // and split-sum specular, with the single-scattering and the multiple-scattering variants, and
 // direct Cook-Torrance lights (directional, point). Small functions, one per product, so that a
 // scene pays only for what it bakes (no diffuse IBL: call only specular_ibl; no DFG LUT: no
@@ -97,7 +97,7 @@
 //   radius^2 tan^2(r/2) / v.h. Head-on with R at the cap centre this is exact for every alpha:
 //   the cap holds the fraction t^2 / (alpha^2 + t^2) (t = tan(r/2)) of D n.h, which
 //   D(n; alpha') = 1 / (pi alpha'^2) reproduces. Measured against the exact cap integral of the
-//   same BRDF (integrate/disk_light.hpp) on a 1-degree sun over normals 0..80 degrees from it and
+//   same BRDF (reference/disk_light.hpp) on a 1-degree sun over normals 0..80 degrees from it and
 //   reflection offsets 0..5 degrees (relative error, floored at 1e-3 of the peak): mean / max
 //   0.3% / 1.6% at r = 0.5, 1.9% / 13% at r = 0.3, 7% / 41% at r = 0.2, 34% / 150% at r = 0.1.
 //   Below r ~ 0.2 the lobe is narrower than the sun and the shape of the highlight (a flat disk
@@ -116,16 +116,16 @@
 //   and a light at the shading point give 0, never NaN. For finite inputs every function here
 //   returns finite values for r in {0, 1} and n.v in {0, 1} included.
 
-#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
-#include "brdf/fresnel.hpp"
-#include "brdf/ggx.hpp"
-#include "brdf/lambert.hpp"
-#include "brdf/masking.hpp"
-#include "core/constants.hpp"
-#include "core/math.hpp"
-#include "core/vec.hpp"
+#include "../brdf/fresnel.hpp"
+#include "../brdf/ggx.hpp"
+#include "../brdf/lambert.hpp"
+#include "../brdf/masking.hpp"
+#include "../core/constants.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
 
 namespace ibl {
 

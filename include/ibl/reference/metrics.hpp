@@ -1,5 +1,5 @@
 #pragma once
-// ibl/integrate/metrics.hpp — error metrics of a computed product against a reference (host only).
+// ibl/reference/metrics.hpp — error metrics of a computed product against a reference (host only).
 //
 // Elements are the RGB components of texels: a texel of three channels is three elements. All
 // sums are in double (the inputs may be float), in element order (deterministic).

@@ -1,10 +1,10 @@
 #pragma once
-// ibl/occlusion.hpp — specular occlusion at run time from the visible fraction of the specular
-// lobe (value functions; the table is built by integrate/occlusion.hpp).
+// ibl/runtime/specular_occlusion.hpp — specular occlusion at run time from the visible fraction of the specular
+// lobe (value functions; the table is built by reference/occluded_specular.hpp).
 //
 // ---- The quantity -------------------------------------------------------------------------------
 //   A shading point at normal n sees the environment inside a cone of half-angle theta_o about n
-//   (the visibility model of integrate/occlusion.hpp with the bent normal b = n). Its ambient
+//   (the visibility model of reference/occluded_specular.hpp with the bent normal b = n). Its ambient
 //   occlusion, the cosine-weighted visible fraction, is ao = sin^2 theta_o, so the cone is known
 //   from ao alone: cos theta_o = sqrt(1 - ao). The specular occlusion factor is the share of the
 //   specular lobe p(l) = D V (n.l) (Fresnel excluded) that falls inside the cone,
@@ -25,15 +25,15 @@
 // Domains: n.v, r, ao in [0, 1] (clamped); a null or smaller than 2^3 table reads 1 (no occlusion). IBL_FUNC on a raw pointer (device code may read a
 // table in its own memory); the overload on specular_occlusion_lut is a host function.
 
-#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
 #include <cstddef>
 #include <cstdint>
 #include <vector>
 
-#include "core/math.hpp"
-#include "core/vec.hpp"
+#include "../core/math.hpp"
+#include "../core/vec.hpp"
 
 namespace ibl {
 

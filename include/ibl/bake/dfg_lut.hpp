@@ -1,11 +1,11 @@
 #pragma once
-// ibl/integrate/dfg_lut.hpp — the DFG look-up table: generation (exact or Monte Carlo) through the
+// ibl/bake/dfg_lut.hpp — the DFG look-up table: generation (exact or Monte Carlo) through the
 // batch kernels and an executor, layout, and bilinear lookup (host only).
 //
 // Layout (float32, interleaved channels, row-major): data[(j * size + i) * channels + c], row j
 // one roughness, row 0 first in memory (uploaded as is, row 0 is the texture's first row, v = 0
 // in GL/Vulkan/D3D texel addressing). Which (n.v, r) a texel holds is the table's `layout`
-// (integrate/dfg_layout.hpp), recorded in the table and read from it by every lookup:
+// (runtime/dfg_layout.hpp), recorded in the table and read from it by every lookup:
 //   the default, dfg_lut_layout::uniform() (the textbook table):
 //     texel (i, j): n.v = (i + 0.5) / size, r = (j + 0.5) / size (texel centres: r = 0 and n.v = 0
 //     themselves are half a texel outside, as in a GPU texture sampled with clamp-to-edge), so a
@@ -15,7 +15,7 @@
 // The table also records the BRDF model it integrates (`model`: Model::name, "custom" for a
 // model without one).
 //   channel 0 = A (scale of F0), 1 = B (bias, scale of F90), 2 (optional) = k = (1 - E)/E,
-//   E = A + B: Turquin's multiple-scattering compensation (integrate/dfg_multiscatter.hpp).
+//   E = A + B: Turquin's multiple-scattering compensation (bake/dfg_multiscatter.hpp).
 //
 // Work: rows are independent and go through the executor (core/executor.hpp); within a row the
 // batch kernels take W texels at a time (W = 8 doubles for the quadrature, 16 floats for Monte
@@ -38,46 +38,11 @@
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "dfg.hpp"
-#include "dfg_layout.hpp"
+#include "../runtime/dfg_layout.hpp"
 #include "dfg_multiscatter.hpp"
+#include "../runtime/tables.hpp"
 
 namespace ibl {
-
-struct dfg_lut {
-    std::uint32_t size = 0;     ///< texels per side
-    std::uint32_t channels = 0; ///< 2 (A, B) or 3 (A, B, k)
-    std::vector<float> data;    ///< (j * size + i) * channels + c
-    dfg_lut_layout layout{};    ///< which (n.v, r) each texel holds (default: the textbook table)
-    std::string model = "custom"; ///< the BRDF model integrated (Model::name)
-
-    /// n.v at the centre of column i.
-    double n_dot_v(std::uint32_t i) const noexcept {
-        return dfg_texel_value<double>(layout.n_dot_v, i, size, layout.edge_aligned);
-    }
-    /// Roughness at the centre of row j.
-    double roughness(std::uint32_t j) const noexcept {
-        return dfg_texel_value<double>(layout.roughness, j, size, layout.edge_aligned);
-    }
-    /// Texel value. Precondition (noexcept, IBL_ASSERT in debug builds): i, j < size, c < channels,
-    /// data holds size^2 channels floats.
-    float at(std::uint32_t i, std::uint32_t j, std::uint32_t c) const noexcept {
-        IBL_ASSERT(i < size && j < size && c < channels);
-        return data[(std::size_t(j) * size + i) * channels + c];
-    }
-    /// True when data holds size^2 * channels floats of a non-empty table (what sample() needs).
-    bool valid() const noexcept {
-        return size > 0 && channels > 0 && data.size() == std::size_t(size) * size * channels;
-    }
-    /// Bilinear lookup at (n.v, r) in the table's layout with clamp-to-edge, as a GPU sampler does
-    /// (channel 2 is 0 for a two-channel table; the same read as lookup.hpp's dfg_lookup). A table
-    /// that is not valid() (empty, or data of the wrong length) samples as 0 instead of reading out
-    /// of bounds.
-    vec3<float> sample(float n_dot_v, float rough) const noexcept {
-        if (!valid()) return vec3<float>(0.0f);
-        const vec2<float> st = dfg_lut_coord(n_dot_v, rough, size, layout);
-        return dfg_sample_st(*this, st.x, st.y);
-    }
-};
 
 namespace detail {
 template <class Model> std::string model_name() {

@@ -1,14 +1,14 @@
 #pragma once
-// ibl/plan.hpp — the scene-driven bake plan: which products, mip levels, resolutions,
+// ibl/bake/plan.hpp — the scene-driven bake plan: which products, mip levels, resolutions,
 // SH bands, DFG table size and sample counts a scene needs, chosen from the scene's materials and
 // an error target with the library's measured error-vs-cost relations. Pure arithmetic on the
-// scene description: depends on core/ and integrate/roughness_mip.hpp only (no integrator code).
+// scene description: depends on core/ and runtime/roughness_mip.hpp only (no integrator code).
 //
 // ---- What the error target means --------------------------------------------------------------
 //   error_target is the relative error allowed in the PRODUCTS as the scene samples them, against
 //   converged products of the same layout (a bake with many samples, full resolution, exact DFG,
 //   brute-force irradiance). It is NOT the error of the split-sum approximation against the true
-//   integral (integrate/radiance_reference.hpp): that error (tens of per cent under a sun, see
+//   integral (reference/radiance.hpp): that error (tens of per cent under a sun, see
 //   examples/split_sum_error.cpp) belongs to the shading model, and no product plan can reduce it.
 //   Per product (each must meet the target on its own measure):
 //     specular  normalised RMSE (RMSE / RMS of the reference) of each used prefiltered level;
@@ -19,7 +19,7 @@
 //
 // ---- Specular: which levels (the contiguous-chain decision) ------------------------------------
 //   The engine's chain convention is fixed by plan_settings: `levels` L and a roughness_mip_policy
-//   (integrate/roughness_mip.hpp) map roughness r to a continuous lod in [0, L - 1] of a virtual
+//   (runtime/roughness_mip.hpp) map roughness r to a continuous lod in [0, L - 1] of a virtual
 //   chain whose level v has face size max(1, base >> v). A trilinear lookup at lod reads levels
 //   floor(lod) and ceil(lod), so a roughness range [lo, hi] needs the levels
 //   floor(lod(lo)) .. ceil(lod(hi)). A GPU mip chain is contiguous from its base, so the plan STORES
@@ -97,7 +97,7 @@
 //       3 bands  0.120
 //   bands = 2 if the diffuse target >= sh2_irradiance_error, 3 if >= sh3_irradiance_error,
 //   otherwise an irradiance cubemap
-//   (integrate/irradiance.hpp, 32^2, 1024 filtered cosine samples) whose band limit is not 3.
+//   (bake/irradiance.hpp, 32^2, 1024 filtered cosine samples) whose band limit is not 3.
 //   plan_limits::max_sh_bands caps the bands (a warning says when the target is then missed).
 //
 // ---- DFG table -----------------------------------------------------------------------------------
@@ -128,7 +128,7 @@
 //   bake's dfg_size in [1, limits::max_dfg_lut_size]: std::invalid_argument below a domain,
 //   std::length_error above a bound (core/limits.hpp).
 
-#include "core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
 #include <algorithm>
@@ -139,9 +139,9 @@
 #include <string>
 #include <vector>
 
-#include "core/constants.hpp"
-#include "core/limits.hpp"
-#include "integrate/roughness_mip.hpp"
+#include "../core/constants.hpp"
+#include "../core/limits.hpp"
+#include "../runtime/roughness_mip.hpp"
 
 namespace ibl {
 

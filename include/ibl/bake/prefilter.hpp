@@ -1,9 +1,9 @@
 #pragma once
-// ibl/integrate/prefilter.hpp — the prefiltered specular environment: the split-sum LD term per
+// ibl/bake/prefilter.hpp — the prefiltered specular environment: the split-sum LD term per
 // roughness, one roughness per mip level (host only).
 //
 // Derivation. The split-sum approximation (B. Karis, "Real Shading in Unreal Engine 4", SIGGRAPH
-// 2013 course notes) factors the specular integral into DFG (integrate/dfg*.hpp) and
+// 2013 course notes) factors the specular integral into DFG (bake/dfg*.hpp) and
 //     LD(R) = integral L(l) D(h) max(n.l, 0) dl / integral D(h) max(n.l, 0) dl
 // with the isotropic assumption N = V = R (h = normalize(R + l)). Sampling h from the GGX NDF
 // (pdf_h = D(h) n.h, sampling/ggx.hpp) and reflecting V about h gives l with
@@ -53,7 +53,7 @@
 // Sample tables. Per output level one table of N Hammersley points (i / N, radical inverse),
 // shared by every texel: tangent-space l, weight n.l, lod; samples with n.l <= 0 are dropped.
 // Per texel the table is rotated into the frame make_frame(R) of the texel centre R. The hot loop
-// is the cubemap fast path of integrate/sphere_convolve.hpp (structure of arrays over a face row,
+// is the cubemap fast path of bake/sphere_convolve.hpp (structure of arrays over a face row,
 // one bilinear tap per sample on a level that is the same for every texel, or two for trilinear
 // reads; blocked float accumulation).
 //
@@ -96,9 +96,9 @@
 #include "../sampling/ggx.hpp"
 #include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
-#include "chain.hpp"
-#include "ld_weight.hpp"
-#include "roughness_mip.hpp"
+#include "../runtime/chain.hpp"
+#include "../runtime/ld_weight.hpp"
+#include "../runtime/roughness_mip.hpp"
 #include "sphere_convolve.hpp"
 
 namespace ibl {
@@ -293,7 +293,7 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 } // namespace detail
 
 /// The prefiltered mip chain of an environment for lobe L (a specular_chain: the levels and the
-/// weight and mapping they were filtered with, integrate/chain.hpp) (sampling/lobe.hpp; GGX by default,
+/// weight and mapping they were filtered with, runtime/chain.hpp) (sampling/lobe.hpp; GGX by default,
 /// prefilter<ibl::charlie_lobe>(env, opt) for sheen): level l holds LD for roughness
 /// opt.policy.roughness(l, levels) at face size max(1, base >> l). Level 0 is the copy of the
 /// source when the lobe's r = 0 limit is the mirror (GGX), else convolved at r = policy.roughness(0)

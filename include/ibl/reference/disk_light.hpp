@@ -1,9 +1,9 @@
 #pragma once
-// ibl/integrate/disk_light.hpp — host quadratures of a disk light (shade.hpp's disk_light<T>, a
+// ibl/reference/disk_light.hpp — host quadratures of a disk light (runtime/shade.hpp's disk_light<T>, a
 // sun that env/sun_extract.hpp removed from an environment), in double (host only).
 //
 // * disk_light_ld(light, R, r, nodes): the disk's exact contribution to the prefiltered LD term
-//   (integrate/prefilter.hpp: w(l) = D(h) max(R.l, 0), h = normalize(R + l), N = V = R),
+//   (bake/prefilter.hpp: w(l) = D(h) max(R.l, 0), h = normalize(R + l), N = V = R),
 //       LD_disk(R) = L * integral over the cap of w(l) dl / W(alpha)
 //   with W from ggx_ld_normaliser, so that the LD of the original environment is the residual's LD
 //   plus this (LD is linear in L with a common denominator). Quadrature in polar coordinates
@@ -22,15 +22,15 @@
 //   the direction towards the sun, cos^2(psi - psi_c) >= (cos^2 r - cos^2 gamma) / sin^2 gamma,
 //   where the inner integral vanishes like a square root: psi = psi_c + Delta sin(s) with
 //   Gauss-Legendre in s in [-pi/2, pi/2] removes it. Cost 4 nodes inner integrals.
-//   LD weight (integrate/ld_weight.hpp): with ld_weight::g1 the weight is D(h) G1(R.l), so the
+//   LD weight (runtime/ld_weight.hpp): with ld_weight::g1 the weight is D(h) G1(R.l), so the
 //   inner integrand cos(rho(u)) becomes G1(cos rho(u)) (no closed form: `nodes` Gauss-Legendre
 //   nodes in u over the interval, 1 - u interpolated between its ends, which are exact in
 //   tau = tan^2(rho/2), so a sharp lobe keeps its resolution) and W is ggx_ld_normaliser_g1.
 // * disk_light_specular_reference(n, v, light, f0, f90, r, nodes): the exact cap integral of the
-//   disk light's specular BRDF of shade.hpp (GGX D, height-correlated Smith V, Schlick F: the
+//   disk light's specular BRDF of runtime/shade.hpp (GGX D, height-correlated Smith V, Schlick F: the
 //   image-based products' model), integral L f(v, l) max(n.l, 0) dl, by the midpoint rule in polar
 //   coordinates about the disk centre (nodes radial x 4 nodes azimuthal): the reference that
-//   disk_light_specular (the widened lobe of shade.hpp) is measured against.
+//   disk_light_specular (the widened lobe of runtime/shade.hpp) is measured against.
 // * disk_light_irradiance_reference(n, light, nodes): integral L max(n.l, 0) dl over the cap by
 //   the same rule (a check of the closed form of disk_light_irradiance).
 
@@ -48,8 +48,8 @@
 #include "../core/math.hpp"
 #include "../core/sum.hpp"
 #include "../core/vec.hpp"
-#include "../shade.hpp"
-#include "reference.hpp"
+#include "../runtime/shade.hpp"
+#include "ld_irradiance.hpp"
 
 namespace ibl {
 

@@ -1,10 +1,10 @@
 #pragma once
-// ibl/integrate/chain.hpp — a prefiltered specular chain that records its conventions.
+// ibl/runtime/chain.hpp — a prefiltered specular chain that records its conventions.
 //
 // prefilter() returns a specular_chain: the cubemap of the levels plus the LD weight its levels
 // were filtered with and the roughness <-> lod mapping of its levels. It is a cubemap<float>, so
-// every function that takes a cubemap takes it; the lookups that read a chain (lookup.hpp,
-// runtime.hpp) take the chain as a template parameter and, given a specular_chain,
+// every function that takes a cubemap takes it; the lookups that read a chain (runtime/lookup.hpp,
+// runtime/specular_models.hpp) take the chain as a template parameter and, given a specular_chain,
 //   * read the mapping from the chain (the lookup description's mapping is the chain's: a chain
 //     cannot be read at the lods of another mapping), and
 //   * refuse a lobe table fitted to another weight (std::invalid_argument naming both): the lobe

@@ -1,8 +1,8 @@
 #pragma once
-// ibl/integrate/reference.hpp — converged references for the prefiltered LD term and for
+// ibl/reference/ld_irradiance.hpp — converged references for the prefiltered LD term and for
 // irradiance, in double, to measure the products' errors against (host only; slow by design).
 //
-// LD (definitions in integrate/prefilter.hpp):
+// LD (definitions in bake/prefilter.hpp):
 //   LD(R) = integral L(l) w(l) dl / W,   w(l) = D(h) max(n.l, 0),  h = normalize(R + l),  N = V = R
 //   W(alpha) = integral w(l) dl over the sphere.
 // * reference_ld(env, R, r, samples): GGX importance sampling with the n.l weights (the same
@@ -19,7 +19,7 @@
 //   which cancels as alpha -> 1 (b -> 0); there, with x = b / a in [0, 1),
 //     I = (1 / a) sum_{k >= 1} x^(k-1) / (k (k + 1))            (used for x <= 1/2).
 //   W = 4 I: W -> 4 as alpha -> 0 (a mirror), W = 1 at alpha = 1.
-// * LD weight (integrate/ld_weight.hpp): every LD reference takes the weight of the chain it is
+// * LD weight (runtime/ld_weight.hpp): every LD reference takes the weight of the chain it is
 //   compared with (default ld_weight::n_dot_l, Karis's w above). ld_weight::g1 replaces max(n.l, 0)
 //   by G1(n.l) in w and in W: ggx_ld_normaliser_g1(alpha) = 4 integral_0^u* G1(n.l(u)) du by
 //   midpoint rules (in u down to n.l = 1/2, then in n.l, where G1 falls to 0 over n.l ~ alpha;
@@ -31,7 +31,7 @@
 //   step), the cap integral by a product midpoint rule in polar coordinates about the sun
 //   direction (cap_nodes radial x 4 cap_nodes azimuthal nodes; error O((r_sun / cap_nodes)^2)
 //   relative, the cap edge is followed exactly), W in closed form. Deterministic.
-// Irradiance (integrate/irradiance.hpp): E(n) = integral over n's hemisphere of L(l) (n.l) dl.
+// Irradiance (bake/irradiance.hpp): E(n) = integral over n's hemisphere of L(l) (n.l) dl.
 // * reference_irradiance(env, n, samples): cosine-weighted Hammersley points, E = pi mean L,
 //   Neumaier sums in double.
 // * reference_irradiance_sky(sky, n, samples, cap_nodes): E_sky by reference_irradiance on the
@@ -79,7 +79,7 @@
 #include "../sampling/hemisphere.hpp"
 #include "../sampling/lobe.hpp"
 #include "../sampling/sequence.hpp"
-#include "ld_weight.hpp"
+#include "../runtime/ld_weight.hpp"
 
 namespace ibl {
 
