@@ -5,6 +5,8 @@
 #      (preset dev-clang); the dev build includes one translation unit per public header (each
 #      header compiles alone) and its ctest includes the nvcc device-compile check when nvcc exists;
 #   3. runs the suite once under AddressSanitizer + UndefinedBehaviorSanitizer (preset sanitize);
+#      the headless-Chromium GLSL tests run in the dev preset only (the shaders and the browser do
+#      not depend on the C++ compiler; the tool paths they drive are covered by the tool tests);
 #   4. installs the package into a temporary prefix and builds and runs a consumer project that
 #      uses find_package(ibl CONFIG REQUIRED);
 #   5. builds and runs a consumer that vendors ibl with add_subdirectory (it checks that ibl then
