@@ -7,7 +7,8 @@
 #   3. runs the suite once under AddressSanitizer + UndefinedBehaviorSanitizer (preset sanitize);
 #      the headless-Chromium GLSL tests run in the dev preset only (the shaders and the browser do
 #      not depend on the C++ compiler; the tool paths they drive are covered by the tool tests);
-#   4. installs the package into a temporary prefix and builds and runs a consumer project that
+#   4. installs the package into a temporary prefix (checking that it holds exactly include/ibl: no
+#      research, example or tool file) and builds and runs a consumer project that
 #      uses find_package(ibl CONFIG REQUIRED);
 #   5. builds and runs a consumer that vendors ibl with add_subdirectory (it checks that ibl then
 #      defines nothing but its INTERFACE library);
@@ -29,6 +30,12 @@ echo "== install + find_package(ibl) consumer"
 prefix=$(mktemp -d)
 trap 'rm -rf "$prefix"' EXIT
 cmake --install build/dev --prefix "$prefix/install" >/dev/null
+# The install tree is the shipping library: exactly include/ibl, no research, study or tool file.
+if find "$prefix/install" | grep -E '/(research|examples|tools)(/|$)'; then
+    echo "the install tree holds research, example or tool files" >&2; exit 1
+fi
+diff <(cd include && find ibl -type f | sort) <(cd "$prefix/install/include" && find ibl -type f | sort) \
+    || { echo "the installed headers differ from include/ibl" >&2; exit 1; }
 cmake -S tests/consumer -B "$prefix/consumer" -G Ninja -DCMAKE_PREFIX_PATH="$prefix/install" \
     -DCMAKE_CXX_FLAGS="-Wall -Wextra -Wpedantic -Werror" >/dev/null
 cmake --build "$prefix/consumer"
