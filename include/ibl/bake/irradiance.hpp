@@ -221,7 +221,7 @@ template <class T> irradiance_texel_moments make_irradiance_texel_moments(const 
             const int by = int((long long)y * m / n);
             for (int x = 0; x < n; ++x) {
                 const int bx = int((long long)x * m / n);
-                const std::size_t b = (std::size_t(f) * std::size_t(m) + std::size_t(by)) * std::size_t(m) + std::size_t(bx);
+                const std::size_t b = cube_texel_index(f, bx, by, m);
                 vec3<double> L(c.texel(f, x, y, 0));
                 for (int k = 0; k < 3; ++k)
                     if (!is_finite(L[k])) L[k] = 0.0;
@@ -260,9 +260,7 @@ cubemap<float> irradiance_cubemap_texel_moments(const cubemap<T>& src, int size 
         }
     });
     cubemap<float> out(n, 1);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     out.update_borders();
     return out;
 }
@@ -312,9 +310,7 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
     const int n = opt.size;
     cubemap<float> out(n, 1);
     const std::vector<vec3<float>> texels = convolve_faces(env, make_irradiance_table_for<float>(env, opt), n, ex);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     out.update_borders();
     return out;
 }
@@ -338,9 +334,7 @@ cubemap<float> irradiance_cubemap_lobe(const Env& env, int size, std::uint32_t s
     table.scale = float(pi_v<double>); // E = pi x the normalised lobe mean
     cubemap<float> out(size, 1);
     const std::vector<vec3<float>> texels = convolve_faces(env, table, size, ex);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(size) + std::size_t(y)) * std::size_t(size) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, size)]; });
     out.update_borders();
     return out;
 }
