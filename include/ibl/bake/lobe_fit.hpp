@@ -135,8 +135,8 @@ inline double lobe_fresnel_part_weight(lobe_fresnel_part part, double v_dot_h) n
 /// (1 - t) K(r_floor(x)) + t K(r_floor(x) + 1), t = frac(x), exactly what the hardware returns.
 struct lobe_fit_options {
     int taps = 1;
-    std::uint32_t nodes = 16;  ///< lobe points nodes^2 (16: the fitted L1 within 2e-3 of 32 nodes')
-    int iterations = 40;       ///< Nelder-Mead iterations per parameter (40: within 1e-3 of 150)
+    std::uint32_t nodes = 16;  ///< lobe points nodes^2 (the default's accuracy: docs/runtime.md, "The fitted lobe")
+    int iterations = 40;       ///< Nelder-Mead iterations per parameter (the default's accuracy: docs/runtime.md)
     std::vector<double> level_roughness;
     /// Extra cost per unit of the mixture's mass below n's horizon (0: the plain L1 distance, which
     /// already counts it once). Radiance below the horizon is unrelated to what the lobe sees, so

@@ -22,26 +22,22 @@
 // cubemap's lod_for_solid_angle; env_lod_for_solid_angle for other sources: analytic sources
 // have no texels and always read lod 0). Krivanek-Colbert and Filament's libibl add a bias of
 // +1 (a footprint of 4 Omega_s). Here the default is +0.5: the bilinear reconstruction of the
-// mips already spreads a texel over about 2 x 2 texels, and on a sky with a sun (bench_prefilter,
-// 256^2 source, 128-256 samples) +1 over-blurs the rough levels (the sun leaks into texels facing
-// away from it: largest overshoot 6-11 times the reference at r = 1) while +0 keeps much of plain
-// importance sampling's noise near the sun (normalised RMSE 0.3 at r >= 0.5 against 0.15-0.25).
+// mips already spreads a texel over about 2 x 2 texels, and on a sky with a sun +1 over-blurs the
+// rough levels (the sun leaks into texels facing away from it) while +0 keeps much of plain
+// importance sampling's noise near the sun (figures: docs/ibl-bake.md, "Quality presets").
 // Fetch: by default each sample blends the two levels around its lod (trilinear, two bilinear
 // taps); trilinear = false reads only the nearest level round(lod) (one tap: half the cost, the
-// lod quantised to whole levels). At equal cost nearest-level reads win (256 nearest against 128
-// trilinear on the sky + sun: relative RMSE per level 0.15/0.15/0.23/0.34 against
-// 0.22/0.25/0.31/0.75), but at 512 samples trilinear reads remove the mottle that nearest reads
-// leave in a sun's glossy highlight (docs/ibl-bake.md, "Quality presets").
-// prefilter tests and bench_prefilter measure it. With bias = -inf (or method = importance) every
-// sample reads level 0: plain importance sampling.
+// lod quantised to whole levels). At equal cost nearest-level reads are the more accurate, but at
+// 512 samples trilinear reads remove the mottle that nearest reads leave in a sun's glossy
+// highlight (figures: docs/ibl-bake.md, "Quality presets"). With bias = -inf (or method =
+// importance) every sample reads level 0: plain importance sampling.
 //
 // Default sample schedule (samples = 0, default_prefilter_samples): 512 samples per texel at
 // level 1 for filtered importance sampling (1024 for plain importance sampling), doubled at each
 // coarser level, capped at 16384. Level l has 4^-l of the base's texels, so the chain still costs
 // under twice its level 1, while the rough levels, where a sun is smeared over many texels, get
-// the samples they need: on the default sky + sun at 256^2 (6 levels, trilinear) the doubling took
-// the worst per-level relative RMSE from 0.206 to 0.082 and the largest overshoot from 2.41 to
-// 1.40 for about 1.45 times the time of a constant 512. This is ibl-bake's default quality.
+// the samples they need (figures: docs/ibl-bake.md, "Quality presets"). This is ibl-bake's
+// default quality.
 //
 // LD weight (prefilter_options::weight). ld_weight::n_dot_l is Karis's n.l above. ld_weight::g1
 // weights each sample by the Smith masking of its direction instead,

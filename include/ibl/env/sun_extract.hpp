@@ -3,7 +3,7 @@
 // from the environment and returns it as a disk light (host only: std::vector work space).
 //
 // Why. A sun carries most of a clear sky's irradiance in ~1e-3 sr. Baked into the environment
-// it defeats the cheap diffuse products (3-band SH: 54% mean error on ibl::make_default_sky) and
+// it defeats the cheap diffuse products (3-band SH cannot hold it: docs/sun.md) and
 // needs many specular samples. Split off, the residual environment is smooth (SH holds it) and
 // the sun is shaded as an analytic disk light (runtime/shade.hpp: disk_light_irradiance, shade_disk;
 // reference/disk_light.hpp: its exact LD contribution to the prefiltered chain).

@@ -71,12 +71,10 @@
 //   (at least 1), batches >= 2 (smaller counts are raised to 2); samples <= limits::max_samples and
 //   batches <= limits::max_batches (core/limits.hpp; std::length_error beyond). The mirror term costs one more evaluation and has zero error.
 //   Caveat (every sample-based error bar has it): a bright feature that no batch hits is
-//   invisible to the standard error. BRDF sampling alone under the default sky's sun at 1024
-//   samples returns a value 99% low with a 0.4% standard error (bench_radiance_reference); with
-//   environment sampling in the mix every batch hits the sun. Use mis for peaked environments.
-//   Figures (default sky, sun reflected by a dielectric at r = 0.3, proposal baked at 128^2):
-//   relative se 4% at 2^10 samples, 1% at 2^12, 0.16% at 2^16, 0.055% at 2^18 (BRDF only: 16%,
-//   5%, 3%, 0.8% at 2^12..2^18). The residual MIS error is the sun's edge: a texel the cap covers
+//   invisible to the standard error: BRDF sampling alone under a small sun can miss it in every
+//   batch and report a value far too low with a small standard error; with environment sampling
+//   in the mix every batch hits the sun. Use mis for peaked environments (figures: docs/runtime.md,
+//   "The full integral"). The residual MIS error is the sun's edge: a texel the cap covers
 //   partly is drawn by its mean luminance and its draws hit or miss the sun (relative variance
 //   (1 - c) / c at coverage c); a finer proposal cube shrinks the partly covered share.
 //
