@@ -156,6 +156,11 @@ template <class Model, std::size_t W, class Eval>
 inline void dfg_full_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& s) noexcept {
     double wy[W];
     Eval ct[W], st[W], pe[W], pb[W];
+    double e[W], b[W]; // the accumulators in locals: no store through s in the loops
+    for (std::size_t l = 0; l < W; ++l) {
+        e[l] = s.e[l];
+        b[l] = s.b[l];
+    }
     for (std::size_t k = 0; k < q.full_n; ++k) {
         for (std::size_t l = 0; l < W; ++l) {
             const double y = s.y1[l] * q.full_x[k];
@@ -174,9 +179,13 @@ inline void dfg_full_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& s) 
                 dfg_accumulate<Model>(s.mu_e[l], s.sin_v_e[l], st[l] * c, ct[l], s.rough[l], pe[l], pb[l]);
         }
         for (std::size_t l = 0; l < W; ++l) {
-            s.e[l] += wy[l] * double(pe[l]);
-            s.b[l] += wy[l] * double(pb[l]);
+            e[l] += wy[l] * double(pe[l]);
+            b[l] += wy[l] * double(pb[l]);
         }
+    }
+    for (std::size_t l = 0; l < W; ++l) {
+        s.e[l] = e[l];
+        s.b[l] = b[l];
     }
 }
 
@@ -186,6 +195,11 @@ template <class Model, std::size_t W, class Eval>
 inline void dfg_partial_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& s) noexcept {
     double wy[W], phi_max[W];
     Eval ct[W], st[W], pe[W], pb[W];
+    double e[W], b[W]; // the accumulators in locals: no store through s in the loops
+    for (std::size_t l = 0; l < W; ++l) {
+        e[l] = s.e[l];
+        b[l] = s.b[l];
+    }
     for (std::size_t k = 0; k < q.part_n; ++k) {
         for (std::size_t l = 0; l < W; ++l) {
             const double y = s.y1[l] + s.len[l] * q.part_s[k];
@@ -213,9 +227,13 @@ inline void dfg_partial_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& 
             }
         }
         for (std::size_t l = 0; l < W; ++l) {
-            s.e[l] += wy[l] * double(pe[l]);
-            s.b[l] += wy[l] * double(pb[l]);
+            e[l] += wy[l] * double(pe[l]);
+            b[l] += wy[l] * double(pb[l]);
         }
+    }
+    for (std::size_t l = 0; l < W; ++l) {
+        s.e[l] = e[l];
+        s.b[l] = b[l];
     }
 }
 } // namespace detail
