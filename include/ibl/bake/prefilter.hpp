@@ -64,7 +64,10 @@
 // mode; prefilter_plan gives the plan of the options (levels 0 .. levels - 1 as above). A given
 // plan bakes any run of consecutive chain levels: output level 0 is then chain level
 // plan[0].level, at face size max(1, base_size >> plan[0].level) (what ibl-bake stores for a
-// scene that reads only some roughness range, with its own samples and reads per level).
+// scene that reads only some roughness range, with its own samples and reads per level). A mirror
+// level 0 with nearest reads (trilinear = false) copies the cubemap source's level nearest in
+// face size (texel for texel where the sizes match, else read at that whole lod; other sources:
+// the footprint's lod rounded); the options' plan reads it at the footprint's lod as above.
 //
 // Bad input: a table of 0 samples (make_ld_table) is clamped to 1 (one sample: h = n, l = R: a mirror lookup at the lod of
 // that sample's footprint). Non-finite source radiance reads as 0 (sphere_convolve.hpp); level 0
@@ -153,7 +156,6 @@ struct prefilter_options {
     /// trilinear are not read.
     std::vector<prefilter_level> level_plan{};
 };
-
 
 /// Ceiling of the doubling sample schedule (samples per texel).
 inline constexpr std::uint32_t prefilter_max_scheduled_samples = 16384;
