@@ -355,6 +355,79 @@ TEST_CASE("prefilter: deterministic for every thread count") {
     for (unsigned t : {1u, 2u, 3u, 7u}) CHECK(bit_equal(ref, ibl::prefilter(src, o, ibl::thread_executor{t})));
 }
 
+namespace {
+/// The level loop ibl-bake ran before prefilter took a level plan: the consecutive levels of
+/// `plan` at face sizes max(1, base >> level), the mirror level 0 copied from the nearest source
+/// level, every other level by its own table.
+ibl::cubemap<float> hand_level_loop(const ibl::cubemap<float>& src, int base, const std::vector<ibl::prefilter_level>& plan) {
+    ibl::cubemap<float> chain(std::max(1, base >> plan.front().level), int(plan.size()));
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+        const ibl::prefilter_level& lp = plan[k];
+        const int n = chain.size(int(k));
+        if (lp.level == 0) {
+            const int sl = std::clamp(int(std::lround(std::log2(double(src.size(0)) / double(n)))), 0, src.levels() - 1);
+            chain.fill(int(k), [&](int f, int x, int y) {
+                return src.size(sl) == n ? src.texel(f, x, y, sl)
+                                         : src.radiance(ibl::cube_texel_direction<float>(f, x, y, n), float(sl));
+            });
+            continue;
+        }
+        ibl::sphere_sample_table<float> table =
+            ibl::make_ld_table_for<float>(src, lp.roughness, lp.samples, ibl::prefilter_method::filtered_importance, 0.5);
+        table.trilinear = lp.trilinear;
+        const std::vector<v3<float>> texels = ibl::convolve_faces(src, table, n, ibl::serial_executor{});
+        chain.fill(int(k), [&](int f, int x, int y) { return texels[ibl::cube_texel_index(f, x, y, n)]; });
+    }
+    chain.update_borders();
+    return chain;
+}
+} // namespace
+
+TEST_CASE("prefilter: a level plan equals the hand level loop and the one-shot chain bit for bit") {
+    const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_lambda_environment<float>(smooth_fn<float>), 16, 2);
+    ibl::prefilter_options o;
+    o.levels = 5;
+    // The default plan: levels 0..4, the policy's roughness, the schedule, trilinear reads.
+    const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(o, 16);
+    REQUIRE(plan.size() == 5);
+    for (int l = 0; l < 5; ++l) {
+        CHECK(plan[std::size_t(l)].level == l);
+        CHECK(plan[std::size_t(l)].roughness == o.policy.roughness(double(l), 5));
+        CHECK(plan[std::size_t(l)].samples == ibl::prefilter_samples(o, l, 5));
+        CHECK(plan[std::size_t(l)].trilinear);
+    }
+    const ibl::cubemap<float> one_shot = ibl::prefilter(src, o, ibl::serial_executor{});
+    ibl::prefilter_options given = o;
+    given.level_plan = plan;
+    CHECK(bit_equal(ibl::prefilter(src, given, ibl::serial_executor{}), one_shot));
+
+    // Levels 2..3 of the same chain: the one-shot chain's levels 2 and 3, texel for texel.
+    given.level_plan = {plan[2], plan[3]};
+    const ibl::cubemap<float> part = ibl::prefilter(src, given, ibl::serial_executor{});
+    REQUIRE(part.levels() == 2);
+    CHECK(part.size(0) == 4);
+    for (int k = 0; k < 2; ++k)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < part.size(k); ++y)
+                for (int x = 0; x < part.size(k); ++x)
+                    CHECK(std::memcmp(&part.texel(f, x, y, k), &one_shot.texel(f, x, y, k + 2), sizeof(v3<float>)) == 0);
+
+    // Per-level samples and reads, the mirror level from the nearest source level (base 8: level
+    // 1 of the 16^2 source, copied; base 6: read at lod 1), against the hand loop.
+    for (int base : {16, 8, 6}) {
+        ibl::prefilter_options p;
+        p.base_size = base;
+        p.level_plan = {{0, 0.0, 0, false}, {1, 0.3, 64, false}, {2, 0.55, 200, true}};
+        CHECK(bit_equal(ibl::prefilter(src, p, ibl::serial_executor{}), hand_level_loop(src, base, p.level_plan)));
+        p.level_plan.erase(p.level_plan.begin());
+        CHECK(bit_equal(ibl::prefilter(src, p, ibl::serial_executor{}), hand_level_loop(src, base, p.level_plan)));
+    }
+    // Levels that are not consecutive are refused.
+    ibl::prefilter_options bad;
+    bad.level_plan = {{1, 0.3, 64, true}, {3, 0.6, 64, true}};
+    CHECK_THROWS_AS((void)ibl::prefilter(src, bad), std::invalid_argument);
+}
+
 TEST_CASE("prefilter: LD is smooth as r -> 1 and finite at r = 1") {
     auto sky = ibl::make_default_sky<float>();
     sky.sun_radiance = v3<float>(0.f);

@@ -411,29 +411,13 @@ void json_triples(json_writer& j, const sh5& c, int count) {
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex) {
-    const int stored_base = std::max(1, sp.virtual_base_size >> sp.first_level);
-    ibl::cubemap<float> chain(stored_base, int(sp.levels.size()));
-    for (std::size_t k = 0; k < sp.levels.size(); ++k) {
-        const ibl::specular_level_plan& lp = sp.levels[k];
-        const int n = chain.size(int(k));
-        if (lp.level == 0) { // the mirror level: the source at the output texel centres
-            const int sl = std::clamp(int(std::lround(std::log2(double(src.size(0)) / double(n)))), 0, src.levels() - 1);
-            chain.fill(int(k), [&](int f, int x, int y) {
-                return src.size(sl) == n ? src.texel(f, x, y, sl)
-                                         : src.radiance(ibl::cube_texel_direction<float>(f, x, y, n), float(sl));
-            });
-            continue;
-        }
-        ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
-            src, lp.roughness, lp.samples, ibl::prefilter_method::filtered_importance, 0.5, w);
-        table.trilinear = lp.trilinear;
-        const std::vector<fvec3> texels = ibl::convolve_faces(src, table, n, ex);
-        chain.fill(int(k), [&](int f, int x, int y) {
-            return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-        });
-    }
-    chain.update_borders();
-    return chain;
+    ibl::prefilter_options o;
+    o.base_size = sp.virtual_base_size;
+    o.policy = sp.policy;
+    o.weight = w;
+    for (const ibl::specular_level_plan& lp : sp.levels) // the mirror level copies the nearest source level
+        o.level_plan.push_back({lp.level, lp.roughness, lp.samples, lp.level > 0 && lp.trilinear});
+    return ibl::cubemap<float>(ibl::prefilter(src, o, ex));
 }
 
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex) {

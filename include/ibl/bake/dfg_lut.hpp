@@ -51,10 +51,9 @@ template <class Model> std::string model_name() {
 }
 } // namespace detail
 
-/// Node counts used for tables (weights evaluated in float, see dfg_quadrature_lanes): largest
-/// error of the 128^2 float table 4.8e-6 (height-correlated) / 4.2e-6 (Schlick k_IBL) against a
-/// converged double reference, both in the first column (bench/bench_dfg.cpp), inside the 1e-5
-/// target, at 432 weight evaluations per texel. {16, 16, 32, 16} gives 4e-7 at 1.8x the cost.
+/// Node counts used for tables (weights evaluated in float, see dfg_quadrature_lanes): 432 weight
+/// evaluations per texel, a 128^2 float table inside the 1e-5 target against a converged double
+/// reference (figures: docs/ARCHITECTURE.md, "Split-sum DFG").
 inline constexpr dfg_quadrature_nodes dfg_lut_default_nodes{12, 12, 24, 12};
 
 namespace detail {

@@ -37,8 +37,8 @@
 //
 // Texel moments (method texel_moments, cubemap sources only: the map that holds under a sun).
 // A sampled estimator misses or over-weights a small bright source, and 3-band SH cannot hold
-// the clamped-cosine kink it makes (on ibl::make_default_sky, SH irradiance is off by 54% on
-// average, 484% at worst). Instead E(n) is the sum over the texels t of level 0 (finest) of
+// the clamped-cosine kink it makes (docs/sun.md gives its error on ibl::make_default_sky).
+// Instead E(n) is the sum over the texels t of level 0 (finest) of
 // L_t Omega_t max(0, n.d_t) (ibl::irradiance_texel_sum's brute force), made cheap by grouping the
 // level-0 texels into the blocks of a coarse grid of face m (the face size of the first mip level
 // whose face is <= texel_max_face; level-0 texel (x, y) goes to block (x m / n, y m / n)) and
@@ -53,8 +53,8 @@
 // variation inside the block). The only error is in blocks that the horizon of n crosses: the
 // clamp is taken once at the mean direction. A sun inside one block is exact except for normals
 // whose horizon crosses the sun itself. (The plain texel sum over mip level m, which puts the
-// block's power at the block centre, moves a 1-degree sun by up to half a block: on the default
-// sky + sun at m = 32 that is a mean error of several per cent; measured in docs/sun.md.)
+// block's power at the block centre, moves a 1-degree sun by up to half a block: docs/sun.md,
+// section 1, compares the two.)
 // Cost: 6 n^2 once (the moments), then 6 m^2 terms per output texel (a dot product, a max, an
 // RGB multiply-add, in double): 6 m^2 x 6 size^2 = 3.8e7 for m = size = 32. Default m <= 32.
 
@@ -221,7 +221,7 @@ template <class T> irradiance_texel_moments make_irradiance_texel_moments(const 
             const int by = int((long long)y * m / n);
             for (int x = 0; x < n; ++x) {
                 const int bx = int((long long)x * m / n);
-                const std::size_t b = (std::size_t(f) * std::size_t(m) + std::size_t(by)) * std::size_t(m) + std::size_t(bx);
+                const std::size_t b = cube_texel_index(f, bx, by, m);
                 vec3<double> L(c.texel(f, x, y, 0));
                 for (int k = 0; k < 3; ++k)
                     if (!is_finite(L[k])) L[k] = 0.0;
@@ -260,9 +260,7 @@ cubemap<float> irradiance_cubemap_texel_moments(const cubemap<T>& src, int size 
         }
     });
     cubemap<float> out(n, 1);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     out.update_borders();
     return out;
 }
@@ -312,9 +310,7 @@ cubemap<float> irradiance_cubemap(const Env& env, const irradiance_options& opt 
     const int n = opt.size;
     cubemap<float> out(n, 1);
     const std::vector<vec3<float>> texels = convolve_faces(env, make_irradiance_table_for<float>(env, opt), n, ex);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     out.update_borders();
     return out;
 }
@@ -338,9 +334,7 @@ cubemap<float> irradiance_cubemap_lobe(const Env& env, int size, std::uint32_t s
     table.scale = float(pi_v<double>); // E = pi x the normalised lobe mean
     cubemap<float> out(size, 1);
     const std::vector<vec3<float>> texels = convolve_faces(env, table, size, ex);
-    out.fill(0, [&](int f, int x, int y) {
-        return texels[(std::size_t(f) * std::size_t(size) + std::size_t(y)) * std::size_t(size) + std::size_t(x)];
-    });
+    out.fill(0, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, size)]; });
     out.update_borders();
     return out;
 }

@@ -135,8 +135,8 @@ inline double lobe_fresnel_part_weight(lobe_fresnel_part part, double v_dot_h) n
 /// (1 - t) K(r_floor(x)) + t K(r_floor(x) + 1), t = frac(x), exactly what the hardware returns.
 struct lobe_fit_options {
     int taps = 1;
-    std::uint32_t nodes = 16;  ///< lobe points nodes^2 (16: the fitted L1 within 2e-3 of 32 nodes')
-    int iterations = 40;       ///< Nelder-Mead iterations per parameter (40: within 1e-3 of 150)
+    std::uint32_t nodes = 16;  ///< lobe points nodes^2 (the default's accuracy: docs/runtime.md, "The fitted lobe")
+    int iterations = 40;       ///< Nelder-Mead iterations per parameter (the default's accuracy: docs/runtime.md)
     std::vector<double> level_roughness;
     /// Extra cost per unit of the mixture's mass below n's horizon (0: the plain L1 distance, which
     /// already counts it once). Radiance below the horizon is unrelated to what the lobe sees, so
@@ -331,6 +331,65 @@ double nelder_mead(F&& f, std::vector<double>& x0, const std::vector<double>& st
     return fv[lo];
 }
 
+/// A roughness as a tap parameter: itself, or with stored level roughness L (lobe_fit_options::
+/// level_roughness) the fractional level where the piecewise-linear L reaches it.
+inline double lobe_tap_value(const std::vector<double>& L, double rr) {
+    if (L.empty()) return rr;
+    if (rr <= L.front()) return 0.0;
+    for (std::size_t i = 1; i < L.size(); ++i)
+        if (rr <= L[i]) return double(i - 1) + (rr - L[i - 1]) / std::max(L[i] - L[i - 1], 1e-12);
+    return double(L.size() - 1);
+}
+
+/// Splits the heaviest of the first nk - 1 taps of x (3 parameters per tap: angle, value, weight)
+/// into two of half its weight at angles a -+ spread / 2; returns the split before the angles
+/// move apart (the same mixture written with nk taps).
+inline std::vector<double> split_heaviest_tap(std::vector<double>& x, int nk, double spread) {
+    int h = 0;
+    for (int k = 1; k < nk - 1; ++k)
+        if (x[std::size_t(3 * k + 2)] > x[std::size_t(3 * h + 2)]) h = k;
+    const double a = x[std::size_t(3 * h)], v = x[std::size_t(3 * h + 1)], wt = x[std::size_t(3 * h + 2)];
+    x[std::size_t(3 * h + 2)] = 0.5 * wt;
+    x.insert(x.end(), {a, v, 0.5 * wt});
+    std::vector<double> same = x;
+    x[std::size_t(3 * h)] = a - 0.5 * spread;
+    x[x.size() - 3] = a + 0.5 * spread;
+    return same;
+}
+
+/// Nelder-Mead on the L1 distance of nk taps from x (plus the leak penalty of the options);
+/// returns the best value, x the best parameters.
+inline double fit_taps(const lobe_points& pts, std::vector<double>& x, int nk, double vmax, double spread, ld_weight w,
+                       const lobe_fit_options& o) {
+    auto f = [&](const double* p) {
+        std::array<lobe_tap, lobe_max_taps> t{};
+        taps_from_params(p, nk, vmax, t);
+        double e = mixture_l1(pts, t, nk, w, o.level_roughness);
+        if (o.leak_weight > 0.0 && o.level_roughness.empty())
+            for (int k = 0; k < nk; ++k)
+                e += o.leak_weight * t[std::size_t(k)].weight * ld_kernel_mass_below(t[std::size_t(k)].angle, t[std::size_t(k)].roughness, w);
+        return e;
+    };
+    std::vector<double> step(x.size());
+    for (std::size_t j = 0; j < x.size(); ++j) step[j] = j % 3 == 0 ? spread : j % 3 == 1 ? 0.1 * vmax : 0.2;
+    return nelder_mead(f, x, step, o.iterations * int(x.size()), o.tolerance);
+}
+
+/// Weights as parameters: clamped at 0 and renormalised to sum 1 (equal when all are <= 0).
+inline void normalise_tap_weights(std::vector<double>& x, int nk) {
+    double ws = 0.0;
+    for (int k = 0; k < nk; ++k) ws += std::max(x[std::size_t(3 * k + 2)], 0.0);
+    for (int k = 0; k < nk; ++k) x[std::size_t(3 * k + 2)] = ws > 0.0 ? std::max(x[std::size_t(3 * k + 2)], 0.0) / ws : 1.0 / nk;
+}
+
+/// The first n taps by increasing angle.
+inline void sort_taps_by_angle(std::array<lobe_tap, lobe_max_taps>& taps, int n) {
+    // sorted through a vector: g++ 12 -O3 reads std::sort over a prefix of the array as out of bounds
+    std::vector<lobe_tap> sorted(taps.begin(), taps.begin() + n);
+    std::sort(sorted.begin(), sorted.end(), [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
+    std::copy(sorted.begin(), sorted.end(), taps.begin());
+}
+
 } // namespace detail
 
 /// The L1-closest mixture of o.taps chain kernels of weight w to the lobe of model M at (n.v, r)
@@ -345,17 +404,8 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     const lobe_moments m = specular_lobe_moments<Model>(mu, r, 32);
     const double r_eff = std::max(ld_matched_roughness(m.rho, w, 256), 0.01);
     const detail::lobe_points pts = detail::make_lobe_points<Model>(mu, r, o.nodes, o.part);
-    const bool lv = !o.level_roughness.empty();
-    const double vmax = lv ? double(o.level_roughness.size() - 1) : 1.0;
-    auto to_value = [&](double rr) { // roughness -> the tap's parameter (lod for stored levels)
-        if (!lv) return rr;
-        const auto& L = o.level_roughness;
-        if (rr <= L.front()) return 0.0;
-        for (std::size_t i = 1; i < L.size(); ++i)
-            if (rr <= L[i]) return double(i - 1) + (rr - L[i - 1]) / std::max(L[i] - L[i - 1], 1e-12);
-        return vmax;
-    };
-    std::vector<double> x{m.phi, to_value(r_eff), 1.0};
+    const double vmax = o.level_roughness.empty() ? 1.0 : double(o.level_roughness.size() - 1);
+    std::vector<double> x{m.phi, detail::lobe_tap_value(o.level_roughness, r_eff), 1.0};
     {
         std::array<lobe_tap, lobe_max_taps> t{};
         detail::taps_from_params(x.data(), 1, 1.0, t);
@@ -366,46 +416,20 @@ lobe_mixture fit_specular_lobe(double n_dot_v, double roughness, ld_weight w, co
     std::vector<double> x_same; // the k - 1 taps' mixture written with k taps (no new freedom used)
     double best_same = 2.0;
     for (int nk = 1; nk <= n_taps; ++nk) {
-        if (nk > 1) { // split the heaviest tap
-            int h = 0;
-            for (int k = 1; k < nk - 1; ++k)
-                if (x[std::size_t(3 * k + 2)] > x[std::size_t(3 * h + 2)]) h = k;
-            const double a = x[std::size_t(3 * h)], v = x[std::size_t(3 * h + 1)], wt = x[std::size_t(3 * h + 2)];
-            x[std::size_t(3 * h + 2)] = 0.5 * wt;
-            x.insert(x.end(), {a, v, 0.5 * wt});
-            x_same = x;
+        if (nk > 1) {
+            x_same = detail::split_heaviest_tap(x, nk, spread);
             best_same = best;
-            x[std::size_t(3 * h)] = a - 0.5 * spread;
-            x[x.size() - 3] = a + 0.5 * spread;
         }
-        auto f = [&](const double* p) {
-            std::array<lobe_tap, lobe_max_taps> t{};
-            detail::taps_from_params(p, nk, vmax, t);
-            double e = detail::mixture_l1(pts, t, nk, w, o.level_roughness);
-            if (o.leak_weight > 0.0 && o.level_roughness.empty())
-                for (int k = 0; k < nk; ++k)
-                    e += o.leak_weight * t[std::size_t(k)].weight * detail::ld_kernel_mass_below(t[std::size_t(k)].angle, t[std::size_t(k)].roughness, w);
-            return e;
-        };
-        std::vector<double> step(x.size());
-        for (std::size_t j = 0; j < x.size(); ++j) step[j] = j % 3 == 0 ? spread : j % 3 == 1 ? 0.1 * vmax : 0.2;
-        best = detail::nelder_mead(f, x, step, o.iterations * int(x.size()), o.tolerance);
+        best = detail::fit_taps(pts, x, nk, vmax, spread, w, o);
         if (nk > 1 && !(best < best_same - o.min_gain)) { // the new tap does not pay: keep the copy
             x = x_same;
             best = best_same;
         }
-        // weights as parameters: renormalise so the next split starts from the same mixture
-        double ws = 0.0;
-        for (int k = 0; k < nk; ++k) ws += std::max(x[std::size_t(3 * k + 2)], 0.0);
-        for (int k = 0; k < nk; ++k) x[std::size_t(3 * k + 2)] = ws > 0.0 ? std::max(x[std::size_t(3 * k + 2)], 0.0) / ws : 1.0 / nk;
+        detail::normalise_tap_weights(x, nk); // the next split starts from the same mixture
     }
     out.count = n_taps;
     detail::taps_from_params(x.data(), n_taps, vmax, out.taps);
-    { // sorted through a vector: g++ 12 -O3 reads std::sort over a prefix of the array as out of bounds
-        std::vector<lobe_tap> sorted(out.taps.begin(), out.taps.begin() + n_taps);
-        std::sort(sorted.begin(), sorted.end(), [](const lobe_tap& a, const lobe_tap& b) { return a.angle < b.angle; });
-        std::copy(sorted.begin(), sorted.end(), out.taps.begin());
-    }
+    detail::sort_taps_by_angle(out.taps, n_taps);
     out.l1 = o.leak_weight > 0.0 ? detail::mixture_l1(pts, out.taps, n_taps, w, o.level_roughness) : best;
     return out;
 }

@@ -22,26 +22,22 @@
 // cubemap's lod_for_solid_angle; env_lod_for_solid_angle for other sources: analytic sources
 // have no texels and always read lod 0). Krivanek-Colbert and Filament's libibl add a bias of
 // +1 (a footprint of 4 Omega_s). Here the default is +0.5: the bilinear reconstruction of the
-// mips already spreads a texel over about 2 x 2 texels, and on a sky with a sun (bench_prefilter,
-// 256^2 source, 128-256 samples) +1 over-blurs the rough levels (the sun leaks into texels facing
-// away from it: largest overshoot 6-11 times the reference at r = 1) while +0 keeps much of plain
-// importance sampling's noise near the sun (normalised RMSE 0.3 at r >= 0.5 against 0.15-0.25).
+// mips already spreads a texel over about 2 x 2 texels, and on a sky with a sun +1 over-blurs the
+// rough levels (the sun leaks into texels facing away from it) while +0 keeps much of plain
+// importance sampling's noise near the sun (figures: docs/ibl-bake.md, "Quality presets").
 // Fetch: by default each sample blends the two levels around its lod (trilinear, two bilinear
 // taps); trilinear = false reads only the nearest level round(lod) (one tap: half the cost, the
-// lod quantised to whole levels). At equal cost nearest-level reads win (256 nearest against 128
-// trilinear on the sky + sun: relative RMSE per level 0.15/0.15/0.23/0.34 against
-// 0.22/0.25/0.31/0.75), but at 512 samples trilinear reads remove the mottle that nearest reads
-// leave in a sun's glossy highlight (docs/ibl-bake.md, "Quality presets").
-// prefilter tests and bench_prefilter measure it. With bias = -inf (or method = importance) every
-// sample reads level 0: plain importance sampling.
+// lod quantised to whole levels). At equal cost nearest-level reads are the more accurate, but at
+// 512 samples trilinear reads remove the mottle that nearest reads leave in a sun's glossy
+// highlight (figures: docs/ibl-bake.md, "Quality presets"). With bias = -inf (or method =
+// importance) every sample reads level 0: plain importance sampling.
 //
 // Default sample schedule (samples = 0, default_prefilter_samples): 512 samples per texel at
 // level 1 for filtered importance sampling (1024 for plain importance sampling), doubled at each
 // coarser level, capped at 16384. Level l has 4^-l of the base's texels, so the chain still costs
 // under twice its level 1, while the rough levels, where a sun is smeared over many texels, get
-// the samples they need: on the default sky + sun at 256^2 (6 levels, trilinear) the doubling took
-// the worst per-level relative RMSE from 0.206 to 0.082 and the largest overshoot from 2.41 to
-// 1.40 for about 1.45 times the time of a constant 512. This is ibl-bake's default quality.
+// the samples they need (figures: docs/ibl-bake.md, "Quality presets"). This is ibl-bake's
+// default quality.
 //
 // LD weight (prefilter_options::weight). ld_weight::n_dot_l is Karis's n.l above. ld_weight::g1
 // weights each sample by the Smith masking of its direction instead,
@@ -62,6 +58,16 @@
 // every lobe whose r = 0 limit is the mirror; sampling/lobe.hpp): a copy of the source
 // (texel for texel when the source is a cubemap of the same face size; otherwise the source's
 // radiance at the output texel centres, read at the lod of the output texel's solid angle).
+//
+// Level plan (prefilter_options::level_plan, prefilter_level). The output is a list of levels,
+// each a chain level l (face size max(1, base_size >> l)), a roughness, a sample count and a read
+// mode; prefilter_plan gives the plan of the options (levels 0 .. levels - 1 as above). A given
+// plan bakes any run of consecutive chain levels: output level 0 is then chain level
+// plan[0].level, at face size max(1, base_size >> plan[0].level) (what ibl-bake stores for a
+// scene that reads only some roughness range, with its own samples and reads per level). A mirror
+// level 0 with nearest reads (trilinear = false) copies the cubemap source's level nearest in
+// face size (texel for texel where the sizes match, else read at that whole lod; other sources:
+// the footprint's lod rounded); the options' plan reads it at the footprint's lod as above.
 //
 // Bad input: a table of 0 samples (make_ld_table) is clamped to 1 (one sample: h = n, l = R: a mirror lookup at the lod of
 // that sample's footprint). Non-finite source radiance reads as 0 (sphere_convolve.hpp); level 0
@@ -108,6 +114,17 @@ enum class prefilter_method : int {
     filtered_importance = 1, ///< Krivanek-Colbert filtered importance sampling
 };
 
+/// One output level of a prefilter plan (prefilter_options::level_plan, prefilter_plan).
+struct prefilter_level {
+    int level = 0;             ///< level l of the chain: face size max(1, base_size >> l)
+    double roughness = 0.0;    ///< the lobe's roughness at this level
+    std::uint32_t samples = 0; ///< samples drawn per texel (0 reads as 1, make_ld_table); unused by a mirror level 0
+    /// Source reads: true = trilinear at each sample's lod, false = the nearest level. A mirror
+    /// level 0 (a copy of the source): true reads at the lod of the output texel's footprint,
+    /// false copies the nearest source level (texel for texel where its face size is the output's).
+    bool trilinear = true;
+};
+
 struct prefilter_options {
     /// levels = automatic (the default, ibl-bake's rule): floor(log2 base) - 1 clamped to [2, 6]
     /// and to the full chain (256 -> 6 levels, 256..8; the smallest face >= 4 for base >= 16; at
@@ -134,6 +151,10 @@ struct prefilter_options {
     bool trilinear = true;
     /// The LD weight (header: "LD weight"); the default is Karis's n.l.
     ld_weight weight = ld_weight::n_dot_l;
+    /// The per-level plan (header: "Level plan"); empty (the default) = the plan of the fields
+    /// above, prefilter_plan(opt, base). When set, levels, samples, samples_per_level and
+    /// trilinear are not read.
+    std::vector<prefilter_level> level_plan{};
 };
 
 /// Ceiling of the doubling sample schedule (samples per texel).
@@ -210,9 +231,15 @@ template <class Env> int prefilter_base_size(const Env& env, int base_size) {
     throw std::invalid_argument("ibl::prefilter: base_size must be >= 1 for a source without a size");
 }
 
-/// Level 0: the source at the output's texel centres (lod of the output texel footprint).
+/// The source level nearest in face size to n (a mirror level 0 with nearest reads).
+template <class Env> int prefilter_nearest_level(const Env& env, int n) {
+    return std::clamp(int(std::lround(std::log2(double(env.size(0)) / double(n)))), 0, env.levels() - 1);
+}
+
+/// Level 0 of a mirror lobe: the source at the output's texel centres, read at the lod of the
+/// output texel's footprint (trilinear) or at the nearest source level (prefilter_level::trilinear).
 template <class Env, class Executor>
-std::vector<vec3<float>> prefilter_base(const Env& env, int n, Executor& ex) {
+std::vector<vec3<float>> prefilter_base(const Env& env, int n, bool trilinear, Executor& ex) {
     using Te = std::conditional_t<environment<Env, float>, float, double>;
     std::vector<vec3<float>> out(std::size_t(6) * std::size_t(n) * std::size_t(n));
     auto finite = [](const vec3<Te>& v) {
@@ -220,17 +247,19 @@ std::vector<vec3<float>> prefilter_base(const Env& env, int n, Executor& ex) {
         for (int k = 0; k < 3; ++k) o[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
         return o;
     };
+    Te lod = env_lod_for_solid_angle<Te>(env, Te(four_pi_v<double> / (6.0 * double(n) * double(n))));
     if constexpr (requires { detail::pack_cube(env); }) {
-        if (env.size(0) == n) { // the same texels: an exact copy
+        const int sl = trilinear ? 0 : prefilter_nearest_level(env, n);
+        if (env.size(sl) == n) { // the same texels: an exact copy
             for (int f = 0; f < 6; ++f)
                 for (int y = 0; y < n; ++y)
-                    for (int x = 0; x < n; ++x)
-                        out[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)] =
-                            finite(vec3<Te>(env.texel(f, x, y, 0)));
+                    for (int x = 0; x < n; ++x) out[cube_texel_index(f, x, y, n)] = finite(vec3<Te>(env.texel(f, x, y, sl)));
             return out;
         }
+        if (!trilinear) lod = Te(sl);
+    } else if (!trilinear) {
+        lod = std::round(lod);
     }
-    const Te lod = env_lod_for_solid_angle<Te>(env, Te(four_pi_v<double> / (6.0 * double(n) * double(n))));
     ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
         for (std::size_t row = b; row < e; ++row) {
             const int face = int(row) / n, y = int(row) % n;
@@ -273,20 +302,54 @@ inline std::uint32_t prefilter_samples(const prefilter_options& opt, int level, 
     return default_prefilter_samples(opt.method, level);
 }
 
+/// The levels prefilter computes for the options (header: "Level plan"): opt.level_plan when set,
+/// else levels 0 .. prefilter_levels(opt, base_size) - 1 at roughness opt.policy.roughness(l, levels)
+/// with prefilter_samples(opt, l, levels) samples and opt.trilinear reads (a mirror level 0 of lobe
+/// L reads at the footprint's lod). Throws as prefilter_levels.
+template <class Lobe = ggx_lobe>
+    requires ld_lobe<Lobe>
+std::vector<prefilter_level> prefilter_plan(const prefilter_options& opt, int base_size) {
+    if (!opt.level_plan.empty()) return opt.level_plan;
+    const int levels = prefilter_levels(opt, base_size);
+    std::vector<prefilter_level> plan;
+    for (int l = 0; l < levels; ++l)
+        plan.push_back({l, opt.policy.roughness(double(l), levels), prefilter_samples(opt, l, levels),
+                        opt.trilinear || (l == 0 && lobe_mirror_limit<Lobe>())});
+    return plan;
+}
+
 namespace detail {
-/// The sample counts of every level within limits::max_samples and the total taps within
-/// limits::max_work (prefilter's checks, before any table is built).
-inline void check_prefilter_work(const prefilter_options& opt, int base, int levels) {
+/// The options' sample counts within limits::max_samples.
+inline void check_prefilter_samples(const prefilter_options& opt) {
     check_total("prefilter", "samples", opt.samples, limits::max_samples, "limits::max_samples");
     for (std::size_t l = 0; l < opt.samples_per_level.size(); ++l)
         if (opt.samples_per_level[l] > limits::max_samples)
             throw std::length_error("ibl::prefilter: samples_per_level[" + std::to_string(l) +
                                     "] = " + std::to_string(opt.samples_per_level[l]) +
                                     " exceeds limits::max_samples = " + std::to_string(limits::max_samples));
+}
+
+/// A given level plan: consecutive levels from a first level in [0, 30], samples within limits::max_samples.
+inline void check_level_plan(const std::vector<prefilter_level>& plan) {
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+        const int want = plan[0].level + int(k);
+        if (plan[k].level != want || want < 0 || want > 30)
+            throw std::invalid_argument("ibl::prefilter: level_plan[" + std::to_string(k) + "].level = " +
+                                        std::to_string(plan[k].level) + ": levels must be consecutive, in [0, 30]");
+        check_total("prefilter", "level_plan samples", plan[k].samples, limits::max_samples, "limits::max_samples");
+    }
+}
+
+/// prefilter's checks, before any table is built: the sample counts of the options or of the
+/// given plan, and the total taps of the plan's levels >= 1 within limits::max_work.
+inline void check_prefilter_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int base) {
+    if (opt.level_plan.empty()) check_prefilter_samples(opt);
+    else check_level_plan(plan);
     std::uint64_t work = 0;
-    for (int l = 1; l < levels; ++l) {
-        const std::uint64_t n = std::uint64_t(base >> l > 0 ? base >> l : 1);
-        work = work_add(work, 6 * n * n, std::uint64_t(prefilter_samples(opt, l, levels)) * (opt.trilinear ? 2u : 1u));
+    for (const prefilter_level& lp : plan) {
+        if (lp.level < 1) continue;
+        const std::uint64_t n = std::uint64_t(base >> lp.level > 0 ? base >> lp.level : 1);
+        work = work_add(work, 6 * n * n, std::uint64_t(lp.samples) * (lp.trilinear ? 2u : 1u));
     }
     check_total("prefilter", "taps (sum of 6 n_l^2 samples_l)", work, limits::max_work, "limits::max_work");
 }
@@ -294,36 +357,36 @@ inline void check_prefilter_work(const prefilter_options& opt, int base, int lev
 
 /// The prefiltered mip chain of an environment for lobe L (a specular_chain: the levels and the
 /// weight and mapping they were filtered with, runtime/chain.hpp) (sampling/lobe.hpp; GGX by default,
-/// prefilter<ibl::charlie_lobe>(env, opt) for sheen): level l holds LD for roughness
-/// opt.policy.roughness(l, levels) at face size max(1, base >> l). Level 0 is the copy of the
-/// source when the lobe's r = 0 limit is the mirror (GGX), else convolved at r = policy.roughness(0)
-/// with the samples of level 0 (prefilter_samples). Cubemap sources (with their mip chain
-/// generated) take the fast path; any other environment is evaluated per sample.
-/// Throws std::invalid_argument for base_size < 0 (or 0 without a source size) and levels < 0,
-/// std::length_error for base_size > limits::max_face_size, a level's samples (opt.samples or
-/// samples_per_level[l]) > limits::max_samples, or a total work sum over levels of
-/// 6 n_l^2 samples_l (x 2 when trilinear) > limits::max_work, before any work.
+/// prefilter<ibl::charlie_lobe>(env, opt) for sheen): output level k holds LD of the plan's level
+/// k (prefilter_plan: by default level l at roughness opt.policy.roughness(l, levels), face size
+/// max(1, base >> l)). Chain level 0 is the copy of the source when the lobe's r = 0 limit is the
+/// mirror (GGX), else convolved at its roughness with its samples. Cubemap sources (with their
+/// mip chain generated) take the fast path; any other environment is evaluated per sample.
+/// Throws std::invalid_argument for base_size < 0 (or 0 without a source size), levels < 0 and a
+/// level_plan whose levels are not consecutive in [0, 30], std::length_error for base_size >
+/// limits::max_face_size, a level's samples (opt.samples, samples_per_level[l] or the plan's) >
+/// limits::max_samples, or a total work sum over levels >= 1 of 6 n_l^2 samples_l (x 2 when
+/// trilinear) > limits::max_work, before any work.
 template <class Lobe = ggx_lobe, class Env, class Executor = thread_executor>
     requires ld_lobe<Lobe>
 specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Executor&& ex = Executor{}) {
     const int base = detail::prefilter_base_size(env, opt.base_size);
-    const int levels = prefilter_levels(opt, base);
-    detail::check_prefilter_work(opt, base, levels);
-    cubemap<float> out(base, levels);
-    auto store = [&](int level, const std::vector<vec3<float>>& texels) {
-        const int n = out.size(level);
-        out.fill(level, [&](int f, int x, int y) {
-            return texels[(std::size_t(f) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-        });
-    };
-    constexpr bool mirror_base = lobe_mirror_limit<Lobe>();
-    if constexpr (mirror_base) store(0, detail::prefilter_base(env, base, ex));
-    for (int l = mirror_base ? 1 : 0; l < levels; ++l) {
-        const double r = opt.policy.roughness(double(l), levels);
-        sphere_sample_table<float> table =
-            make_ld_table_for<float, Lobe>(env, r, prefilter_samples(opt, l, levels), opt.method, opt.lod_bias, opt.weight);
-        table.trilinear = opt.trilinear;
-        store(l, convolve_faces(env, table, out.size(l), ex));
+    const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
+    detail::check_prefilter_work(opt, plan, base);
+    cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()));
+    for (int k = 0; k < int(plan.size()); ++k) {
+        const prefilter_level& lp = plan[std::size_t(k)];
+        const int n = out.size(k);
+        std::vector<vec3<float>> texels;
+        if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
+            texels = detail::prefilter_base(env, n, lp.trilinear, ex);
+        } else {
+            sphere_sample_table<float> table =
+                make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt.method, opt.lod_bias, opt.weight);
+            table.trilinear = lp.trilinear;
+            texels = convolve_faces(env, table, n, ex);
+        }
+        out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     }
     out.update_borders();
     return specular_chain(std::move(out), opt.weight, opt.policy.mapping);

@@ -124,81 +124,104 @@ IBL_FUNC_VOID void dfg_panel_limits(double mu, double sin_v, double alpha2, doub
 }
 } // namespace detail
 
-/// Deterministic DFG of W texels sharing one roughness. The panel geometry, node positions and
-/// all accumulation are in double; the weight itself (the inner phi loops, the cost) is evaluated
-/// in Eval: double for the reference entry points, float for tables (twice the SIMD lanes; its
-/// relative rounding ~1e-7 per evaluation is far below the tables' 1e-5 target, and the sums over
-/// phi have at most a few dozen terms before they join the double accumulators).
-/// Output per lane: e = E = A + B and b = B.
-template <class Model, std::size_t W, class Eval = double>
-inline void dfg_quadrature_lanes(const dfg_quadrature_view& q, double roughness, const double* n_dot_v, double* e_out,
-                                 double* b_out) noexcept {
-    const double alpha = clamp_alpha(double(Model::alpha(roughness)));
-    const double alpha2 = alpha * alpha;
+namespace detail {
+/// The per-lane state of dfg_quadrature_lanes: the view (mu, sin(theta_v)), the panel limits
+/// (y1, len = y2 - y1), the accumulators (e, b) in double and the Eval copies of the inputs.
+template <std::size_t W, class Eval> struct dfg_lanes {
+    double alpha2;
     double mu[W], sin_v[W], y1[W], len[W], e[W], b[W];
     Eval mu_e[W], sin_v_e[W], rough[W]; // rough: uniform, held per lane (see dfg_mc_lanes)
+};
+
+template <std::size_t W, class Eval>
+inline void dfg_lanes_init(dfg_lanes<W, Eval>& s, double alpha2, double roughness, const double* n_dot_v) noexcept {
+    s.alpha2 = alpha2;
     for (std::size_t l = 0; l < W; ++l) {
-        mu[l] = saturate(n_dot_v[l]);
-        sin_v[l] = detail::dfg_sin_view(mu[l]);
+        s.mu[l] = saturate(n_dot_v[l]);
+        s.sin_v[l] = dfg_sin_view(s.mu[l]);
         double y2;
-        detail::dfg_panel_limits(mu[l], sin_v[l], alpha2, y1[l], y2);
-        len[l] = y2 - y1[l];
-        e[l] = 0.0;
-        b[l] = 0.0;
-        mu_e[l] = Eval(mu[l]);
-        sin_v_e[l] = Eval(sin_v[l]);
-        rough[l] = Eval(roughness);
+        dfg_panel_limits(s.mu[l], s.sin_v[l], alpha2, s.y1[l], y2);
+        s.len[l] = y2 - s.y1[l];
+        s.e[l] = 0.0;
+        s.b[l] = 0.0;
+        s.mu_e[l] = Eval(s.mu[l]);
+        s.sin_v_e[l] = Eval(s.sin_v[l]);
+        s.rough[l] = Eval(roughness);
     }
-    double wy[W], phi_max[W];
+}
+
+/// Panel 1, theta_h in [0, theta1]: the whole phi circle is valid; midpoint rule in phi
+/// (exponentially convergent for the smooth periodic integrand), Gauss-Legendre in y.
+template <class Model, std::size_t W, class Eval>
+inline void dfg_full_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& s) noexcept {
+    double wy[W];
     Eval ct[W], st[W], pe[W], pb[W];
-    // Panel 1, theta_h in [0, theta1]: the whole phi circle is valid; midpoint rule in phi
-    // (exponentially convergent for the smooth periodic integrand), Gauss-Legendre in y.
+    double e[W], b[W]; // the accumulators in locals: no store through s in the loops
+    for (std::size_t l = 0; l < W; ++l) {
+        e[l] = s.e[l];
+        b[l] = s.b[l];
+    }
     for (std::size_t k = 0; k < q.full_n; ++k) {
         for (std::size_t l = 0; l < W; ++l) {
-            const double y = y1[l] * q.full_x[k];
-            const double em = detail::lane_expm1_nonneg(y); // e^y - 1
-            const double tan2 = alpha2 * em;                 // tan^2(theta_h) = alpha^2 (e^y - 1)
+            const double y = s.y1[l] * q.full_x[k];
+            const double em = lane_expm1_nonneg(y); // e^y - 1
+            const double tan2 = s.alpha2 * em;      // tan^2(theta_h) = alpha^2 (e^y - 1)
             const double inv = 1.0 / (1.0 + tan2);
             ct[l] = Eval(std::sqrt(inv));
             st[l] = Eval(std::sqrt(tan2 * inv));
-            wy[l] = y1[l] * q.full_w[k] / (1.0 + em) / double(q.full_m); // du = e^-y dy; mean over phi
+            wy[l] = s.y1[l] * q.full_w[k] / (1.0 + em) / double(q.full_m); // du = e^-y dy; mean over phi
             pe[l] = Eval(0);
             pb[l] = Eval(0);
         }
         for (std::size_t j = 0; j < q.full_m; ++j) {
             const Eval c = Eval(q.full_cos[j]);
             for (std::size_t l = 0; l < W; ++l)
-                detail::dfg_accumulate<Model>(mu_e[l], sin_v_e[l], st[l] * c, ct[l], rough[l], pe[l], pb[l]);
+                dfg_accumulate<Model>(s.mu_e[l], s.sin_v_e[l], st[l] * c, ct[l], s.rough[l], pe[l], pb[l]);
         }
         for (std::size_t l = 0; l < W; ++l) {
             e[l] += wy[l] * double(pe[l]);
             b[l] += wy[l] * double(pb[l]);
         }
     }
-    // Panel 2, theta_h in [theta1, theta2]: phi in [0, phi_max], cos(phi_max) = -mu cot(2 theta_h)
-    // / sin(theta_v); the sin^2 map of y removes the (y - y_i)^(3/2) endpoint behaviour.
+    for (std::size_t l = 0; l < W; ++l) {
+        s.e[l] = e[l];
+        s.b[l] = b[l];
+    }
+}
+
+/// Panel 2, theta_h in [theta1, theta2]: phi in [0, phi_max], cos(phi_max) = -mu cot(2 theta_h)
+/// / sin(theta_v); the sin^2 map of y removes the (y - y_i)^(3/2) endpoint behaviour.
+template <class Model, std::size_t W, class Eval>
+inline void dfg_partial_panel(const dfg_quadrature_view& q, dfg_lanes<W, Eval>& s) noexcept {
+    double wy[W], phi_max[W];
+    Eval ct[W], st[W], pe[W], pb[W];
+    double e[W], b[W]; // the accumulators in locals: no store through s in the loops
+    for (std::size_t l = 0; l < W; ++l) {
+        e[l] = s.e[l];
+        b[l] = s.b[l];
+    }
     for (std::size_t k = 0; k < q.part_n; ++k) {
         for (std::size_t l = 0; l < W; ++l) {
-            const double y = y1[l] + len[l] * q.part_s[k];
-            const double em = detail::lane_expm1_nonneg(y);
-            const double tan2 = alpha2 * em;
+            const double y = s.y1[l] + s.len[l] * q.part_s[k];
+            const double em = lane_expm1_nonneg(y);
+            const double tan2 = s.alpha2 * em;
             const double inv = 1.0 / (1.0 + tan2);
             ct[l] = Eval(std::sqrt(inv));
             st[l] = Eval(std::sqrt(tan2 * inv));
             // cot(2 theta) = (1 - tan^2) / (2 tan); NaN (0/0, only outside every used node) and
             // values beyond [-1, 1] clamp to the full or empty circle.
-            const double c_star = -mu[l] * (1.0 - tan2) / (2.0 * std::sqrt(tan2) * sin_v[l]);
-            phi_max[l] = detail::lane_acos(c_star);
-            wy[l] = len[l] * q.part_w[k] / (1.0 + em) * phi_max[l] * inv_pi_v<double>;
+            const double c_star = -s.mu[l] * (1.0 - tan2) / (2.0 * std::sqrt(tan2) * s.sin_v[l]);
+            phi_max[l] = lane_acos(c_star);
+            wy[l] = s.len[l] * q.part_w[k] / (1.0 + em) * phi_max[l] * inv_pi_v<double>;
             pe[l] = Eval(0);
             pb[l] = Eval(0);
         }
         for (std::size_t j = 0; j < q.part_m; ++j) {
             const Eval xi = Eval(q.part_xi[j]), xw = Eval(q.part_xw[j]);
             for (std::size_t l = 0; l < W; ++l) {
-                const Eval c = detail::lane_cos_0_pi(Eval(phi_max[l]) * xi);
+                const Eval c = lane_cos_0_pi(Eval(phi_max[l]) * xi);
                 Eval de = Eval(0), db = Eval(0);
-                detail::dfg_accumulate<Model>(mu_e[l], sin_v_e[l], st[l] * c, ct[l], rough[l], de, db);
+                dfg_accumulate<Model>(s.mu_e[l], s.sin_v_e[l], st[l] * c, ct[l], s.rough[l], de, db);
                 pe[l] += xw * de;
                 pb[l] += xw * db;
             }
@@ -209,8 +232,29 @@ inline void dfg_quadrature_lanes(const dfg_quadrature_view& q, double roughness,
         }
     }
     for (std::size_t l = 0; l < W; ++l) {
-        e_out[l] = e[l];
-        b_out[l] = b[l];
+        s.e[l] = e[l];
+        s.b[l] = b[l];
+    }
+}
+} // namespace detail
+
+/// Deterministic DFG of W texels sharing one roughness. The panel geometry, node positions and
+/// all accumulation are in double; the weight itself (the inner phi loops, the cost) is evaluated
+/// in Eval: double for the reference entry points, float for tables (twice the SIMD lanes; its
+/// relative rounding ~1e-7 per evaluation is far below the tables' 1e-5 target, and the sums over
+/// phi have at most a few dozen terms before they join the double accumulators).
+/// Output per lane: e = E = A + B and b = B.
+template <class Model, std::size_t W, class Eval = double>
+inline void dfg_quadrature_lanes(const dfg_quadrature_view& q, double roughness, const double* n_dot_v, double* e_out,
+                                 double* b_out) noexcept {
+    const double alpha = clamp_alpha(double(Model::alpha(roughness)));
+    detail::dfg_lanes<W, Eval> s;
+    detail::dfg_lanes_init(s, alpha * alpha, roughness, n_dot_v);
+    detail::dfg_full_panel<Model>(q, s);
+    detail::dfg_partial_panel<Model>(q, s);
+    for (std::size_t l = 0; l < W; ++l) {
+        e_out[l] = s.e[l];
+        b_out[l] = s.b[l];
     }
 }
 

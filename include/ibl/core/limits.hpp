@@ -25,8 +25,9 @@
 //   max_work           2^34       total integrand evaluations of one bake call (bake_cubemap's
 //                                 6 n^2 k^2 sub-samples, prefilter's and irradiance_cubemap's
 //                                 texels x taps, a DFG table's texels x nodes or samples): about
-//                                 4 minutes on one core at the measured 14.7 ns per tap, seconds
-//                                 with a thread executor; no single argument buys hours of work.
+//                                 minutes on one core (the time per tap: docs/ARCHITECTURE.md,
+//                                 "Limits"), seconds with a thread executor; no single argument
+//                                 buys hours of work.
 //   max_subsamples     64         bake_cubemap's k (k^2 = 4096 sub-samples per texel, far past
 //                                 the O(1 / (n k)^2) accuracy any product needs).
 //   max_quadrature_nodes 256      each count of dfg_quadrature_nodes (2 x 256^2 weight

@@ -98,9 +98,7 @@ cubemap<T> bake_cubemap(const Env& env, int n, int k, Executor&& ex = Executor{}
             }
         }
     });
-    cube.fill(0, [&](int face, int x, int y) {
-        return base[(std::size_t(face) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)];
-    });
+    cube.fill(0, [&](int face, int x, int y) { return base[cube_texel_index(face, x, y, n)]; });
     cube.generate_mips(ex);
     return cube;
 }

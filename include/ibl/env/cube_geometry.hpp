@@ -29,6 +29,7 @@
 #if IBL_DETAIL_CXX20
 
 #include <cmath>
+#include <cstddef>
 
 #include "../core/constants.hpp"
 #include "../core/vec.hpp"
@@ -65,6 +66,12 @@ template <class T> IBL_FUNC vec3<T> cube_direction(int face, T s, T t) noexcept 
 template <class T> IBL_FUNC vec3<T> cube_texel_direction(int face, int x, int y, int n) noexcept {
     const T inv = T(1) / T(n);
     return cube_direction(face, (T(x) + T(0.5)) * inv, (T(y) + T(0.5)) * inv);
+}
+
+/// Index of texel (x, y) of face `face` in six packed n x n faces (face-major, then rows, then
+/// columns: the layout of the bakers' per-texel results).
+IBL_FUNC std::size_t cube_texel_index(int face, int x, int y, int n) noexcept {
+    return (std::size_t(face) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x);
 }
 
 /// Face and (s, t) of a direction (need not be unit; must be non-zero). For the zero vector and

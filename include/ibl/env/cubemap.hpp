@@ -72,7 +72,7 @@ namespace ibl {
 namespace detail {
 /// cube_lookup without data-dependent branches (selects only): the same face, s and t bit for
 /// bit, including the X-before-Y-before-Z tie rule and the zero/NaN fallback. Random directions
-/// make the branches of cube_lookup mispredict (~19 ns against ~2.5 ns for coherent ones).
+/// make the branches of cube_lookup mispredict (timings: docs/ARCHITECTURE.md, "Environments").
 template <class T> IBL_FUNC cube_coord<T> cube_lookup_select(const vec3<T>& r) noexcept {
     using std::fabs;
     const T ax = fabs(r.x), ay = fabs(r.y), az = fabs(r.z);

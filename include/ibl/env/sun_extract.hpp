@@ -3,7 +3,7 @@
 // from the environment and returns it as a disk light (host only: std::vector work space).
 //
 // Why. A sun carries most of a clear sky's irradiance in ~1e-3 sr. Baked into the environment
-// it defeats the cheap diffuse products (3-band SH: 54% mean error on ibl::make_default_sky) and
+// it defeats the cheap diffuse products (3-band SH cannot hold it: docs/sun.md) and
 // needs many specular samples. Split off, the residual environment is smooth (SH holds it) and
 // the sun is shaded as an analytic disk light (runtime/shade.hpp: disk_light_irradiance, shade_disk;
 // reference/disk_light.hpp: its exact LD contribution to the prefiltered chain).
@@ -122,144 +122,165 @@ inline std::size_t sun_neighbour(int face, int x, int y, int dx, int dy, int n) 
         gx = std::clamp(int(c.s * double(n)), 0, n - 1);
         gy = std::clamp(int(c.t * double(n)), 0, n - 1);
     }
-    return (std::size_t(g) * std::size_t(n) + std::size_t(gy)) * std::size_t(n) + std::size_t(gx);
+    return cube_texel_index(g, gx, gy, n);
 }
-} // namespace detail
 
-/// Finds the sun of level 0 of `cube` by the header's rule; when found, removes it in place (fill
-/// at level 0, mips rebuilt through ex) and returns the light. Otherwise `cube` is unchanged.
-template <class T, class Executor = serial_executor>
-sun_extraction<T> extract_sun_in_place(cubemap<T>& cube, const sun_extract_options& opt = {}, Executor&& ex = Executor{}) {
-    sun_extraction<T> out;
-    const int n = cube.size(0);
-    const std::size_t nn = std::size_t(n) * std::size_t(n), count = 6 * nn;
-    auto texel_of = [&](std::size_t i) -> const vec3<T>& {
-        return cube.texel(int(i / nn), int(i % std::size_t(n)), int((i / std::size_t(n)) % std::size_t(n)), 0);
-    };
-    auto coords = [&](std::size_t i, int& f, int& x, int& y) {
+inline double sun_luminance(const vec3<double>& v) { return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z; }
+
+/// Level 0 of a cube as six packed n x n faces (index cube_texel_index): the texels, their solid
+/// angles (one face's, shared) and their luminances (non-finite channels read as 0).
+template <class T> struct sun_grid {
+    const cubemap<T>& cube;
+    int n;
+    std::size_t nn, count;
+    std::vector<double> omega, Y;
+
+    explicit sun_grid(const cubemap<T>& c)
+        : cube(c), n(c.size(0)), nn(std::size_t(n) * std::size_t(n)), count(6 * nn), omega(nn), Y(count) {
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+        for (std::size_t i = 0; i < count; ++i) Y[i] = sun_luminance(finite(i));
+    }
+    void coords(std::size_t i, int& f, int& x, int& y) const {
         f = int(i / nn);
         y = int((i / std::size_t(n)) % std::size_t(n));
         x = int(i % std::size_t(n));
-    };
-    auto lum = [](const vec3<double>& v) { return 0.2126 * v.x + 0.7152 * v.y + 0.0722 * v.z; };
-    auto finite_d = [](const vec3<T>& v) {
-        vec3<double> d(v);
+    }
+    vec3<double> finite(std::size_t i) const {
+        int f, x, y;
+        coords(i, f, x, y);
+        vec3<double> d(cube.texel(f, x, y, 0));
         for (int k = 0; k < 3; ++k)
             if (!is_finite(d[k])) d[k] = 0.0;
         return d;
-    };
-    std::vector<double> omega(nn);
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+    }
+    double solid_angle(std::size_t i) const { return omega[i % nn]; }
+    vec3<double> direction(std::size_t i) const {
+        int f, x, y;
+        coords(i, f, x, y);
+        return cube_texel_direction<double>(f, x, y, n);
+    }
+};
 
-    // 1. luminance, peak, median, threshold
-    std::vector<double> Y(count);
+/// Step 1: the peak texel, the median luminance and the threshold (into out).
+template <class T> std::size_t sun_statistics(const sun_grid<T>& g, const sun_extract_options& opt, sun_extraction<T>& out) {
     std::size_t peak = 0;
-    for (std::size_t i = 0; i < count; ++i) {
-        Y[i] = lum(finite_d(texel_of(i)));
-        if (Y[i] > Y[peak]) peak = i;
-    }
-    {
-        std::vector<double> tmp = Y;
-        auto mid = tmp.begin() + std::ptrdiff_t(count / 2);
-        std::nth_element(tmp.begin(), mid, tmp.end());
-        out.median_luminance = *mid;
-    }
-    out.peak_luminance = Y[peak];
+    for (std::size_t i = 0; i < g.count; ++i)
+        if (g.Y[i] > g.Y[peak]) peak = i;
+    std::vector<double> tmp = g.Y;
+    auto mid = tmp.begin() + std::ptrdiff_t(g.count / 2);
+    std::nth_element(tmp.begin(), mid, tmp.end());
+    out.median_luminance = *mid;
+    out.peak_luminance = g.Y[peak];
     out.threshold = std::max(opt.threshold_over_median * out.median_luminance, opt.threshold_over_peak * out.peak_luminance);
-    if (!(out.peak_luminance > out.threshold) || !(out.peak_luminance > 0.0)) return out;
+    return peak;
+}
 
-    // 2-3. region growth (8-connected), bounded by max_solid_angle
-    std::vector<std::uint8_t> in(count, 0);
+/// Steps 2-3: the 8-connected region of texels above the threshold grown from the peak, stopped
+/// once its solid angle exceeds max_solid_angle; `in` marks its texels.
+template <class T>
+std::vector<std::size_t> sun_region(const sun_grid<T>& g, std::size_t peak, double threshold, double max_solid_angle,
+                                    std::vector<std::uint8_t>& in, double& region_omega) {
+    in.assign(g.count, 0);
     std::vector<std::size_t> region{peak};
     in[peak] = 1;
-    double region_omega = omega[peak % nn];
+    region_omega = g.solid_angle(peak);
     for (std::size_t k = 0; k < region.size(); ++k) {
         int f, x, y;
-        coords(region[k], f, x, y);
+        g.coords(region[k], f, x, y);
         for (int dy = -1; dy <= 1; ++dy)
             for (int dx = -1; dx <= 1; ++dx) {
                 if (dx == 0 && dy == 0) continue;
-                const std::size_t j = detail::sun_neighbour(f, x, y, dx, dy, n);
-                if (in[j] || !(Y[j] > out.threshold)) continue;
+                const std::size_t j = sun_neighbour(f, x, y, dx, dy, g.n);
+                if (in[j] || !(g.Y[j] > threshold)) continue;
                 in[j] = 1;
                 region.push_back(j);
-                region_omega += omega[j % nn];
+                region_omega += g.solid_angle(j);
             }
-        if (region_omega > opt.max_solid_angle) break;
+        if (region_omega > max_solid_angle) break;
     }
-    out.region_texels = region.size();
-    out.region_solid_angle = T(region_omega);
-    if (region_omega > opt.max_solid_angle) {
-        out.status = sun_status::too_large;
-        return out;
-    }
-    std::sort(region.begin(), region.end()); // a fixed order for the fill and the sums
+    return region;
+}
 
-    // 4. harmonic fill from the 4-connected ring
+/// Step 4, the relaxation: successive over-relaxation of the region's values `val` towards the
+/// mean of their 4 neighbours `nb` (a region texel's value, or the texel outside it).
+template <class T>
+void sun_relax(const sun_grid<T>& g, const std::vector<std::uint8_t>& in, const std::vector<std::size_t>& nb,
+               const std::vector<std::size_t>& slot, std::vector<vec3<double>>& val, int max_sweeps, double ring_luminance) {
+    // Over-relaxation factor of a region of diameter ~ sqrt(texels) (Young's optimum for a
+    // square of that side); any factor in (0, 2) converges to the same harmonic fill.
+    const std::size_t rc = val.size();
+    const double side = std::sqrt(double(rc)) + 2.0;
+    const double w = 2.0 / (1.0 + std::sin(pi_v<double> / side));
+    const double tol = 1e-6 * std::max(ring_luminance, 1e-300);
+    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
+        double change = 0.0;
+        for (std::size_t k = 0; k < rc; ++k) {
+            vec3<double> s(0.0);
+            for (int e = 0; e < 4; ++e) {
+                const std::size_t j = nb[4 * k + std::size_t(e)];
+                s += in[j] ? val[slot[j]] : g.finite(j);
+            }
+            const vec3<double> next = val[k] + w * (0.25 * s - val[k]);
+            change = std::max(change, std::fabs(sun_luminance(next - val[k])));
+            val[k] = next;
+        }
+        if (change <= tol) break;
+    }
+}
+
+/// Step 4: the harmonic fill of the (sorted) region from its 4-connected ring, started at the
+/// ring's mean.
+template <class T>
+std::vector<vec3<double>> sun_harmonic_fill(const sun_grid<T>& g, const std::vector<std::size_t>& region,
+                                            const std::vector<std::uint8_t>& in, int max_sweeps) {
     const std::size_t rc = region.size();
     std::vector<std::size_t> nb(4 * rc);
-    std::vector<vec3<double>> val(rc);
-    std::vector<std::size_t> slot(count, std::size_t(-1)); // region index of a texel
+    std::vector<std::size_t> slot(g.count, std::size_t(-1)); // region index of a texel
     for (std::size_t k = 0; k < rc; ++k) slot[region[k]] = k;
     vec3<double> ring_sum(0.0);
     std::size_t ring_count = 0;
     const int d4[4][2] = {{1, 0}, {-1, 0}, {0, 1}, {0, -1}};
     for (std::size_t k = 0; k < rc; ++k) {
         int f, x, y;
-        coords(region[k], f, x, y);
+        g.coords(region[k], f, x, y);
         for (int e = 0; e < 4; ++e) {
-            const std::size_t j = detail::sun_neighbour(f, x, y, d4[e][0], d4[e][1], n);
+            const std::size_t j = sun_neighbour(f, x, y, d4[e][0], d4[e][1], g.n);
             nb[4 * k + std::size_t(e)] = j;
             if (!in[j]) {
-                ring_sum += finite_d(texel_of(j));
+                ring_sum += g.finite(j);
                 ++ring_count;
             }
         }
     }
     const vec3<double> ring_mean = ring_count ? ring_sum / double(ring_count) : vec3<double>(0.0);
-    std::fill(val.begin(), val.end(), ring_mean);
-    {
-        // Over-relaxation factor of a region of diameter ~ sqrt(texels) (Young's optimum for a
-        // square of that side); any factor in (0, 2) converges to the same harmonic fill.
-        const double side = std::sqrt(double(rc)) + 2.0;
-        const double w = 2.0 / (1.0 + std::sin(pi_v<double> / side));
-        const double tol = 1e-6 * std::max(lum(ring_mean), 1e-300);
-        for (int sweep = 0; sweep < opt.max_fill_sweeps; ++sweep) {
-            double change = 0.0;
-            for (std::size_t k = 0; k < rc; ++k) {
-                vec3<double> s(0.0);
-                for (int e = 0; e < 4; ++e) {
-                    const std::size_t j = nb[4 * k + std::size_t(e)];
-                    s += in[j] ? val[slot[j]] : finite_d(texel_of(j));
-                }
-                const vec3<double> next = val[k] + w * (0.25 * s - val[k]);
-                change = std::max(change, std::fabs(lum(next - val[k])));
-                val[k] = next;
-            }
-            if (change <= tol) break;
-        }
-    }
+    std::vector<vec3<double>> val(rc, ring_mean);
+    sun_relax(g, in, nb, slot, val, max_sweeps, sun_luminance(ring_mean));
+    return val;
+}
 
-    // 5. the light from the excess over the fill
+/// Step 5: the disk light from the region's excess over the fill (into out); false when there is
+/// no excess. dir and e_sun: the light's direction and irradiance facing it.
+template <class T>
+bool sun_light(const sun_grid<T>& g, const std::vector<std::size_t>& region, const std::vector<vec3<double>>& val,
+               sun_extraction<T>& out, vec3<double>& dir, vec3<double>& e_sun) {
+    const std::size_t rc = region.size();
     vec3<double> moment(0.0);
     double peak_excess = 0.0, power_y = 0.0;
     std::vector<vec3<double>> excess(rc), dirs(rc);
     for (std::size_t k = 0; k < rc; ++k) {
-        int f, x, y;
-        coords(region[k], f, x, y);
-        excess[k] = finite_d(texel_of(region[k])) - val[k];
-        dirs[k] = cube_texel_direction<double>(f, x, y, n);
-        const double ey = lum(excess[k]), om = omega[region[k] % nn];
+        excess[k] = g.finite(region[k]) - val[k];
+        dirs[k] = g.direction(region[k]);
+        const double ey = sun_luminance(excess[k]), om = g.solid_angle(region[k]);
         moment += (ey * om) * dirs[k];
         power_y += ey * om;
         peak_excess = std::max(peak_excess, ey);
     }
     const double mlen = glm::length(moment);
-    if (!(mlen > 0.0) || !(peak_excess > 0.0)) return out; // no excess: nothing to extract
-    const vec3<double> dir = moment / mlen;
-    vec3<double> e_sun(0.0);
-    for (std::size_t k = 0; k < rc; ++k) e_sun += excess[k] * (omega[region[k] % nn] * glm::dot(dirs[k], dir));
+    if (!(mlen > 0.0) || !(peak_excess > 0.0)) return false; // no excess: nothing to extract
+    dir = moment / mlen;
+    e_sun = vec3<double>(0.0);
+    for (std::size_t k = 0; k < rc; ++k) e_sun += excess[k] * (g.solid_angle(region[k]) * glm::dot(dirs[k], dir));
     const double sa = std::min(power_y / peak_excess, two_pi_v<double>);
     const double c = sa / two_pi_v<double>; // 1 - cos r
     const double sin2 = c * (2.0 - c);
@@ -268,25 +289,53 @@ sun_extraction<T> extract_sun_in_place(cubemap<T>& cube, const sun_extract_optio
     out.angular_radius = T(std::acos(std::clamp(1.0 - c, -1.0, 1.0)));
     out.irradiance = vec3<T>(e_sun);
     out.radiance = vec3<T>(e_sun / (pi_v<double> * sin2));
+    return true;
+}
 
-    // 6. share of the irradiance facing the light (brute-force texel sum of the original)
+/// Step 6: the light's share of the irradiance facing it (brute-force texel sum of the original).
+template <class T> double sun_share(const sun_grid<T>& g, const vec3<double>& dir, const vec3<double>& e_sun) {
     double e_total = 0.0;
-    for (std::size_t i = 0; i < count; ++i) {
-        int f, x, y;
-        coords(i, f, x, y);
-        const double cs = glm::dot(dir, cube_texel_direction<double>(f, x, y, n));
-        if (cs > 0.0) e_total += Y[i] * omega[i % nn] * cs;
+    for (std::size_t i = 0; i < g.count; ++i) {
+        const double cs = glm::dot(dir, g.direction(i));
+        if (cs > 0.0) e_total += g.Y[i] * g.solid_angle(i) * cs;
     }
-    out.share = e_total > 0.0 ? lum(e_sun) / e_total : 0.0;
+    return e_total > 0.0 ? sun_luminance(e_sun) / e_total : 0.0;
+}
+} // namespace detail
+
+/// Finds the sun of level 0 of `cube` by the header's rule; when found, removes it in place (fill
+/// at level 0, mips rebuilt through ex) and returns the light. Otherwise `cube` is unchanged.
+template <class T, class Executor = serial_executor>
+sun_extraction<T> extract_sun_in_place(cubemap<T>& cube, const sun_extract_options& opt = {}, Executor&& ex = Executor{}) {
+    sun_extraction<T> out;
+    const detail::sun_grid<T> g(cube);
+    const std::size_t peak = detail::sun_statistics(g, opt, out);
+    if (!(out.peak_luminance > out.threshold) || !(out.peak_luminance > 0.0)) return out;
+
+    std::vector<std::uint8_t> in;
+    double region_omega = 0.0;
+    std::vector<std::size_t> region = detail::sun_region(g, peak, out.threshold, opt.max_solid_angle, in, region_omega);
+    out.region_texels = region.size();
+    out.region_solid_angle = T(region_omega);
+    if (region_omega > opt.max_solid_angle) {
+        out.status = sun_status::too_large;
+        return out;
+    }
+    std::sort(region.begin(), region.end()); // a fixed order for the fill and the sums
+
+    const std::vector<vec3<double>> val = detail::sun_harmonic_fill(g, region, in, opt.max_fill_sweeps);
+    vec3<double> dir(0.0), e_sun(0.0);
+    if (!detail::sun_light(g, region, val, out, dir, e_sun)) return out;
+    out.share = detail::sun_share(g, dir, e_sun);
     if (!(out.share >= opt.min_share)) {
         out.status = sun_status::too_weak;
         return out;
     }
 
     // 7. remove: fill level 0, rebuild the mips
-    for (std::size_t k = 0; k < rc; ++k) {
+    for (std::size_t k = 0; k < region.size(); ++k) {
         int f, x, y;
-        coords(region[k], f, x, y);
+        g.coords(region[k], f, x, y);
         cube.set_texel(f, x, y, 0, vec3<T>(val[k]));
     }
     cube.generate_mips(ex);

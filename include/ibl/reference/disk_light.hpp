@@ -69,6 +69,71 @@ inline double disk_inner_g1(double lo, double hi, double alpha, const gauss_lege
     }
     return s * (a2 * (t1 - t0) / ((a2 + t1) * (a2 + t0)));
 }
+
+/// The n.l weight's inner integral over rho in [lo, hi] for b = 1 - alpha^2 >= 1/2 (aq = 1 +
+/// alpha^2, bq = b): the closed form in tau = tan^2(rho/2) (u = tau / (alpha^2 + tau)): 1 - b u =
+/// alpha^2 (1 + tau) / (alpha^2 + tau), finite where u rounds to 1 (a mirror).
+inline double disk_inner_nl_closed(double lo, double hi, double a2, double aq, double bq) {
+    const double t0 = sqr(std::tan(0.5 * lo)), t1 = sqr(std::tan(0.5 * hi));
+    const double du = a2 * (t1 - t0) / ((a2 + t1) * (a2 + t0));
+    // ln((1 + t1)/(1 + t0)) + ln((a2 + t0)/(a2 + t1)), by log1p where the ratio is near 1
+    auto log_ratio_of = [](double num, double den) {
+        return std::fabs(num - den) <= 0.5 * den ? std::log1p((num - den) / den) : std::log(num) - std::log(den);
+    };
+    const double log_ratio = log_ratio_of(1.0 + t1, 1.0 + t0) + log_ratio_of(a2 + t0, a2 + t1);
+    return (aq / bq) * du + (2.0 * a2 / (bq * bq)) * log_ratio;
+}
+
+/// The inner integral of disk_light_ld_weight at azimuth psi about R: the rho interval of the cap
+/// at psi, then the weight's integral over it (G1: disk_inner_g1; n.l: the closed form, or
+/// Gauss-Legendre in u for alpha^2 > 1/2, where the pole 1/b > 2 is far from [0, u*]).
+struct disk_cap_inner {
+    double sin_g, cos_g, psi_c, cos_r, alpha, a2, aq, bq;
+    ld_weight weight;
+    const gauss_legendre_rule& gu;
+
+    double u_of(double rho) const {
+        const double tau = sqr(std::tan(0.5 * rho));
+        return tau / (a2 + tau);
+    }
+    double operator()(double psi) const {
+        const double B = sin_g * std::cos(psi - psi_c), C = std::hypot(cos_g, B);
+        if (!(C > cos_r)) return 0.0;
+        const double phi0 = std::atan2(B, cos_g), delta = std::acos(std::min(1.0, cos_r / C));
+        const double lo = std::max(0.0, phi0 - delta), hi = std::min(half_pi_v<double>, phi0 + delta);
+        if (!(hi > lo)) return 0.0;
+        if (weight == ld_weight::g1) return disk_inner_g1(lo, hi, alpha, gu);
+        if (bq >= 0.5) return disk_inner_nl_closed(lo, hi, a2, aq, bq);
+        const double u0 = u_of(lo), u1 = u_of(hi);
+        double s = 0.0;
+        for (std::size_t k = 0; k < gu.x.size(); ++k) {
+            const double u = u0 + (u1 - u0) * gu.x[k];
+            s += gu.w[k] * std::max(0.0, (1.0 - aq * u) / (1.0 - bq * u));
+        }
+        return s * (u1 - u0);
+    }
+};
+
+/// The outer integral over psi of inner(psi) (gamma: the angle from R to the cap's centre):
+/// the midpoint rule over the whole circle when R is inside the cap, else Gauss-Legendre over the
+/// cap's psi range psi_c -+ Delta with psi = psi_c + Delta sin(s).
+inline double disk_cap_outer(const disk_cap_inner& inner, double gamma, double radius, int nq) {
+    neumaier_sum<double> acc;
+    if (gamma <= radius) {
+        const int np = 4 * nq;
+        const double dp = two_pi_v<double> / double(np);
+        for (int j = 0; j < np; ++j) acc.add(inner((double(j) + 0.5) * dp) * dp);
+    } else {
+        const double q = (inner.cos_r * inner.cos_r - inner.cos_g * inner.cos_g) / (inner.sin_g * inner.sin_g);
+        const double Delta = std::acos(std::sqrt(std::clamp(q, 0.0, 1.0)));
+        const gauss_legendre_rule gp = make_gauss_legendre(std::size_t(4 * nq));
+        for (std::size_t k = 0; k < gp.x.size(); ++k) {
+            const double s = pi_v<double> * (gp.x[k] - 0.5); // [-pi/2, pi/2]
+            acc.add(gp.w[k] * pi_v<double> * Delta * std::cos(s) * inner(inner.psi_c + Delta * std::sin(s)));
+        }
+    }
+    return acc.value();
+}
 } // namespace detail
 
 /// Integral over the cap of the disk light of D(h) k(R.l) dl (see the header; k = max(R.l, 0)
@@ -89,52 +154,8 @@ double disk_light_ld_weight(const disk_light<T>& light, const vec3<double>& dir,
     const vec3<double> dl = fr.to_local(d);
     const double psi_c = std::atan2(dl.y, dl.x), sin_g = std::sqrt(std::max(0.0, 1.0 - cos_g * cos_g));
     const gauss_legendre_rule gu = make_gauss_legendre(std::size_t(nq));
-    auto u_of = [&](double rho) {
-        const double tau = sqr(std::tan(0.5 * rho));
-        return tau / (a2 + tau);
-    };
-    auto inner = [&](double psi) {
-        const double B = sin_g * std::cos(psi - psi_c), C = std::hypot(cos_g, B);
-        if (!(C > cos_r)) return 0.0;
-        const double phi0 = std::atan2(B, cos_g), delta = std::acos(std::min(1.0, cos_r / C));
-        const double lo = std::max(0.0, phi0 - delta), hi = std::min(half_pi_v<double>, phi0 + delta);
-        if (!(hi > lo)) return 0.0;
-        if (weight == ld_weight::g1) return detail::disk_inner_g1(lo, hi, alpha, gu);
-        const double u0 = u_of(lo), u1 = u_of(hi);
-        if (bq >= 0.5) {
-            // closed form in tau = tan^2(rho/2) (u = tau / (alpha^2 + tau)): 1 - b u =
-            // alpha^2 (1 + tau) / (alpha^2 + tau), finite where u rounds to 1 (a mirror)
-            const double t0 = sqr(std::tan(0.5 * lo)), t1 = sqr(std::tan(0.5 * hi));
-            const double du = a2 * (t1 - t0) / ((a2 + t1) * (a2 + t0));
-            // ln((1 + t1)/(1 + t0)) + ln((a2 + t0)/(a2 + t1)), by log1p where the ratio is near 1
-            auto log_ratio_of = [](double num, double den) {
-                return std::fabs(num - den) <= 0.5 * den ? std::log1p((num - den) / den) : std::log(num) - std::log(den);
-            };
-            const double log_ratio = log_ratio_of(1.0 + t1, 1.0 + t0) + log_ratio_of(a2 + t0, a2 + t1);
-            return (aq / bq) * du + (2.0 * a2 / (bq * bq)) * log_ratio;
-        }
-        double s = 0.0; // alpha^2 > 1/2: the pole 1/b > 2 is far from [0, u*]; Gauss-Legendre
-        for (std::size_t k = 0; k < gu.x.size(); ++k) {
-            const double u = u0 + (u1 - u0) * gu.x[k];
-            s += gu.w[k] * std::max(0.0, (1.0 - aq * u) / (1.0 - bq * u));
-        }
-        return s * (u1 - u0);
-    };
-    neumaier_sum<double> acc;
-    if (gamma <= radius) {
-        const int np = 4 * nq;
-        const double dp = two_pi_v<double> / double(np);
-        for (int j = 0; j < np; ++j) acc.add(inner((double(j) + 0.5) * dp) * dp);
-    } else {
-        const double q = (cos_r * cos_r - cos_g * cos_g) / (sin_g * sin_g);
-        const double Delta = std::acos(std::sqrt(std::clamp(q, 0.0, 1.0)));
-        const gauss_legendre_rule gp = make_gauss_legendre(std::size_t(4 * nq));
-        for (std::size_t k = 0; k < gp.x.size(); ++k) {
-            const double s = pi_v<double> * (gp.x[k] - 0.5); // [-pi/2, pi/2]
-            acc.add(gp.w[k] * pi_v<double> * Delta * std::cos(s) * inner(psi_c + Delta * std::sin(s)));
-        }
-    }
-    return (2.0 / pi_v<double>) * acc.value();
+    const detail::disk_cap_inner inner{sin_g, cos_g, psi_c, cos_r, alpha, a2, aq, bq, weight, gu};
+    return (2.0 / pi_v<double>) * detail::disk_cap_outer(inner, gamma, radius, nq);
 }
 
 /// The disk light's contribution to LD at unit R and perceptual roughness r (see the header),

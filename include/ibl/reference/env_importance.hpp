@@ -103,7 +103,7 @@ public:
                 for (int x = 0; x < n_; ++x) {
                     const double yv = texel_luminance(cube, f, x, y, opt);
                     const double wi = yv * omega[std::size_t(y) * n + std::size_t(x)];
-                    w[(std::size_t(f) * n + std::size_t(y)) * n + std::size_t(x)] = wi;
+                    w[cube_texel_index(f, x, y, n_)] = wi;
                     total += wi;
                 }
         const double f_uni = total > 0.0 ? opt.uniform_fraction : 1.0;
@@ -120,7 +120,7 @@ public:
     /// Probability of texel (x, y) of face f (the product of the two CDF steps).
     [[nodiscard]] double texel_probability(int face, int x, int y) const noexcept {
         IBL_ASSERT(face >= 0 && face < 6 && x >= 0 && x < n_ && y >= 0 && y < n_);
-        return p_[(std::size_t(face) * std::size_t(n_) + std::size_t(y)) * std::size_t(n_) + std::size_t(x)];
+        return p_[cube_texel_index(face, x, y, n_)];
     }
 
     /// Draws a direction. Domain: u in [0, 1)^2 (u.x picks the row (face, y) and the t offset,

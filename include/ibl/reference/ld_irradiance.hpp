@@ -42,8 +42,8 @@
 //   Omega_t (cube_texel_solid_angle) and the texel-centre directions d_t (cube_texel_direction),
 //   in double. It is the exact irradiance of the environment that is constant over each texel
 //   *up to the centre rule in each texel*: the cosine is taken at the texel centre, so even a
-//   constant environment is off pi L by O(1 / n^2) (measured: |E - pi L| <= 1.05 L / n^2 for
-//   n >= 8, worst at the face normals; the tests show the 1 / n^2 convergence). Polynomials of
+//   constant environment is off pi L by O(1 / n^2), worst at the face normals (the tests show the
+//   1 / n^2 convergence; figures: docs/sun.md, section 1). Polynomials of
 //   degree <= 2 in d that the cube's symmetries average (e.g. max(0, d_y) max(0, d_y) = d_y^2
 //   on the upper half) come out exact up to rounding. Cost: 6 n^2 multiply-adds per normal (a
 //   dot product, a max, a vec3 multiply-add), plus 6 n^2 directions and n^2 solid angles once;

@@ -71,12 +71,10 @@
 //   (at least 1), batches >= 2 (smaller counts are raised to 2); samples <= limits::max_samples and
 //   batches <= limits::max_batches (core/limits.hpp; std::length_error beyond). The mirror term costs one more evaluation and has zero error.
 //   Caveat (every sample-based error bar has it): a bright feature that no batch hits is
-//   invisible to the standard error. BRDF sampling alone under the default sky's sun at 1024
-//   samples returns a value 99% low with a 0.4% standard error (bench_radiance_reference); with
-//   environment sampling in the mix every batch hits the sun. Use mis for peaked environments.
-//   Figures (default sky, sun reflected by a dielectric at r = 0.3, proposal baked at 128^2):
-//   relative se 4% at 2^10 samples, 1% at 2^12, 0.16% at 2^16, 0.055% at 2^18 (BRDF only: 16%,
-//   5%, 3%, 0.8% at 2^12..2^18). The residual MIS error is the sun's edge: a texel the cap covers
+//   invisible to the standard error: BRDF sampling alone under a small sun can miss it in every
+//   batch and report a value far too low with a small standard error; with environment sampling
+//   in the mix every batch hits the sun. Use mis for peaked environments (figures: docs/runtime.md,
+//   "The full integral"). The residual MIS error is the sun's edge: a texel the cap covers
 //   partly is drawn by its mean luminance and its draws hit or miss the sun (relative variance
 //   (1 - c) / c at coverage c); a finer proposal cube shrinks the partly covered share.
 //
@@ -254,6 +252,75 @@ struct rr_batch {
     vec3<double> parts[2] = {vec3<double>(0.0), vec3<double>(0.0)};
 };
 
+/// One technique's sum over its n draws (seeds seed0, seed1): draw(u) gives a sample (dir, pdf),
+/// q_other(dir) the other technique's count times its pdf; each draw adds its MIS-weighted
+/// g(l) L(l) / pdf to sum[0], sum[1] (the lobe's two parts).
+template <class Lobe, class Env, class Draw, class QOther>
+void rr_technique_sum(const Env& env, const Lobe& lobe, std::uint32_t n, double n_self, std::uint32_t seed0,
+                      std::uint32_t seed1, mis_heuristic h, Draw&& draw, QOther&& q_other, vec3<double> (&sum)[2]) {
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const auto s = draw(scrambled_sobol2(i, seed0, seed1));
+        if (!(s.pdf > 0.0)) continue;
+        const lobe_value g = lobe.eval(s.dir);
+        if (g.parts[0] == vec3<double>(0.0) && g.parts[1] == vec3<double>(0.0)) continue;
+        const double w = rr_mis_weight(n_self * s.pdf, q_other(s.dir), h) / s.pdf;
+        const vec3<double> l = rr_radiance(env, s.dir);
+        sum[0] += (w * l) * g.parts[0];
+        sum[1] += (w * l) * g.parts[1];
+    }
+}
+
+/// Batch k's estimate: n_b lobe draws and n_e environment draws, each technique's sum over its count.
+template <class Lobe, class Env>
+rr_batch rr_batch_estimate(const Env& env, const cube_env_distribution* dist, const Lobe& lobe,
+                           const radiance_reference_options& opt, std::uint32_t kb, std::uint32_t n_b, std::uint32_t n_e) {
+    const double nb = double(n_b), ne = double(n_e);
+    vec3<double> sum_b[2] = {vec3<double>(0.0), vec3<double>(0.0)};
+    vec3<double> sum_e[2] = {vec3<double>(0.0), vec3<double>(0.0)};
+    rr_technique_sum(env, lobe, n_b, nb, rr_seed(opt.seed, kb, 0, 0), rr_seed(opt.seed, kb, 0, 1), opt.heuristic,
+                     [&](const vec2<double>& u) { return lobe.sample(u); },
+                     [&](const vec3<double>& d) { return ne * (n_e > 0 ? dist->pdf(d) : 0.0); }, sum_b);
+    rr_technique_sum(env, lobe, n_e, ne, rr_seed(opt.seed, kb, 1, 0), rr_seed(opt.seed, kb, 1, 1), opt.heuristic,
+                     [&](const vec2<double>& u) { return dist->sample(u); },
+                     [&](const vec3<double>& d) { return nb * (n_b > 0 ? double(lobe.pdf(d)) : 0.0); }, sum_e);
+    rr_batch r;
+    for (int p = 0; p < 2; ++p)
+        r.parts[p] = (n_b > 0 ? sum_b[p] / nb : vec3<double>(0.0)) + (n_e > 0 ? sum_e[p] / ne : vec3<double>(0.0));
+    return r;
+}
+
+/// Mean and standard error of the batch means, folded in batch order.
+inline product_estimate rr_fold_batches(const std::vector<rr_batch>& res) {
+    product_estimate out;
+    const double bn = double(res.size());
+    vec3<double> mean[3] = {vec3<double>(0.0), vec3<double>(0.0), vec3<double>(0.0)};
+    for (const auto& r : res) {
+        mean[0] += r.parts[0];
+        mean[1] += r.parts[1];
+        mean[2] += r.parts[0] + r.parts[1];
+    }
+    for (auto& m : mean) m /= bn;
+    vec3<double> var[3] = {vec3<double>(0.0), vec3<double>(0.0), vec3<double>(0.0)};
+    for (const auto& r : res) {
+        const vec3<double> d0 = r.parts[0] - mean[0], d1 = r.parts[1] - mean[1];
+        const vec3<double> d2 = (r.parts[0] + r.parts[1]) - mean[2];
+        var[0] += d0 * d0;
+        var[1] += d1 * d1;
+        var[2] += d2 * d2;
+    }
+    auto se = [&](const vec3<double>& v) {
+        const vec3<double> q = v / (bn * (bn - 1.0));
+        return vec3<double>(std::sqrt(q.x), std::sqrt(q.y), std::sqrt(q.z));
+    };
+    out.parts[0] = mean[0];
+    out.parts[1] = mean[1];
+    out.value = mean[2];
+    out.parts_std_error[0] = se(var[0]);
+    out.parts_std_error[1] = se(var[1]);
+    out.std_error = se(var[2]);
+    return out;
+}
+
 } // namespace detail
 
 // ---- the generic MIS integrator --------------------------------------------------------------------
@@ -281,71 +348,11 @@ product_estimate integrate_product_mis(const Env& env, const cube_env_distributi
         if (opt.strategy == radiance_strategy::mis) n_e = std::uint32_t(std::floor(opt.env_fraction * double(per_batch)));
     }
     const std::uint32_t n_b = per_batch - n_e;
-    const double nb = double(n_b), ne = double(n_e);
-
     std::vector<detail::rr_batch> res(batches);
     ex(std::size_t(batches), [&](std::size_t begin, std::size_t end) {
-        for (std::size_t k = begin; k < end; ++k) {
-            const std::uint32_t kb = std::uint32_t(k);
-            vec3<double> sum_b[2] = {vec3<double>(0.0), vec3<double>(0.0)};
-            vec3<double> sum_e[2] = {vec3<double>(0.0), vec3<double>(0.0)};
-            const std::uint32_t sb0 = detail::rr_seed(opt.seed, kb, 0, 0), sb1 = detail::rr_seed(opt.seed, kb, 0, 1);
-            for (std::uint32_t i = 0; i < n_b; ++i) {
-                const lobe_sample s = lobe.sample(detail::scrambled_sobol2(i, sb0, sb1));
-                if (!(s.pdf > 0.0)) continue;
-                const lobe_value g = lobe.eval(s.dir);
-                if (g.parts[0] == vec3<double>(0.0) && g.parts[1] == vec3<double>(0.0)) continue;
-                const double pe = n_e > 0 ? dist->pdf(s.dir) : 0.0;
-                const double w = detail::rr_mis_weight(nb * s.pdf, ne * pe, opt.heuristic) / s.pdf;
-                const vec3<double> l = detail::rr_radiance(env, s.dir);
-                sum_b[0] += (w * l) * g.parts[0];
-                sum_b[1] += (w * l) * g.parts[1];
-            }
-            const std::uint32_t se0 = detail::rr_seed(opt.seed, kb, 1, 0), se1 = detail::rr_seed(opt.seed, kb, 1, 1);
-            for (std::uint32_t j = 0; j < n_e; ++j) {
-                const env_sample s = dist->sample(detail::scrambled_sobol2(j, se0, se1));
-                if (!(s.pdf > 0.0)) continue;
-                const lobe_value g = lobe.eval(s.dir);
-                if (g.parts[0] == vec3<double>(0.0) && g.parts[1] == vec3<double>(0.0)) continue;
-                const double pb = n_b > 0 ? double(lobe.pdf(s.dir)) : 0.0;
-                const double w = detail::rr_mis_weight(ne * s.pdf, nb * pb, opt.heuristic) / s.pdf;
-                const vec3<double> l = detail::rr_radiance(env, s.dir);
-                sum_e[0] += (w * l) * g.parts[0];
-                sum_e[1] += (w * l) * g.parts[1];
-            }
-            for (int p = 0; p < 2; ++p)
-                res[k].parts[p] = (n_b > 0 ? sum_b[p] / nb : vec3<double>(0.0)) + (n_e > 0 ? sum_e[p] / ne : vec3<double>(0.0));
-        }
+        for (std::size_t k = begin; k < end; ++k) res[k] = detail::rr_batch_estimate(env, dist, lobe, opt, std::uint32_t(k), n_b, n_e);
     });
-
-    // Mean and standard error of the batch means, folded in batch order.
-    product_estimate out;
-    const double bn = double(batches);
-    vec3<double> mean[3] = {vec3<double>(0.0), vec3<double>(0.0), vec3<double>(0.0)};
-    for (const auto& r : res) {
-        mean[0] += r.parts[0];
-        mean[1] += r.parts[1];
-        mean[2] += r.parts[0] + r.parts[1];
-    }
-    for (auto& m : mean) m /= bn;
-    vec3<double> var[3] = {vec3<double>(0.0), vec3<double>(0.0), vec3<double>(0.0)};
-    for (const auto& r : res) {
-        const vec3<double> d0 = r.parts[0] - mean[0], d1 = r.parts[1] - mean[1];
-        const vec3<double> d2 = (r.parts[0] + r.parts[1]) - mean[2];
-        var[0] += d0 * d0;
-        var[1] += d1 * d1;
-        var[2] += d2 * d2;
-    }
-    auto se = [&](const vec3<double>& v) {
-        const vec3<double> q = v / (bn * (bn - 1.0));
-        return vec3<double>(std::sqrt(q.x), std::sqrt(q.y), std::sqrt(q.z));
-    };
-    out.parts[0] = mean[0];
-    out.parts[1] = mean[1];
-    out.value = mean[2];
-    out.parts_std_error[0] = se(var[0]);
-    out.parts_std_error[1] = se(var[1]);
-    out.std_error = se(var[2]);
+    product_estimate out = detail::rr_fold_batches(res);
     out.samples = std::uint64_t(batches) * per_batch;
     return out;
 }

@@ -87,8 +87,8 @@
 //   V the height-correlated Smith visibility (v_smith_ggx_correlated), the model of the DFG
 //   table and of every reference: a disk light is a part of the environment (an extracted sun),
 //   so it is shaded by the BRDF the image-based products assume, not by the punctual lights'
-//   Schlick-GGX k_direct convention (that remap made the sun's glint 15-33% darker than the
-//   full integral of the environment for a metal at r = 0.5).
+//   Schlick-GGX k_direct convention (that remap makes the sun's glint darker than the full
+//   integral of the environment: docs/sun.md, section 3).
 //       alpha'^2 = alpha^2 + tan^2(r/2) / max(v.h, 1/20),   tan^2(r/2) = (1 - cos r)/(1 + cos r)
 //       L_o = f E_perp n.d,  E_perp = L pi sin^2 r.
 //   Derivation: the cap seen through the half vector is an ellipse of semi-axes r/2 (in the plane
@@ -96,15 +96,13 @@
 //   lobe with it adds its spread to alpha^2 like variances add, with the ellipse's area-equivalent
 //   radius^2 tan^2(r/2) / v.h. Head-on with R at the cap centre this is exact for every alpha:
 //   the cap holds the fraction t^2 / (alpha^2 + t^2) (t = tan(r/2)) of D n.h, which
-//   D(n; alpha') = 1 / (pi alpha'^2) reproduces. Measured against the exact cap integral of the
-//   same BRDF (reference/disk_light.hpp) on a 1-degree sun over normals 0..80 degrees from it and
-//   reflection offsets 0..5 degrees (relative error, floored at 1e-3 of the peak): mean / max
-//   0.3% / 1.6% at r = 0.5, 1.9% / 13% at r = 0.3, 7% / 41% at r = 0.2, 34% / 150% at r = 0.1.
-//   Below r ~ 0.2 the lobe is narrower than the sun and the shape of the highlight (a flat disk
-//   seen obliquely) is beyond one widened lobe. Karis's representative point (Real Shading in
-//   Unreal Engine 4, 2013) with the same normalisation was worse on every roughness of that sweep
-//   (5% / 42% at r = 0.5): it keeps the peak over the whole cap, while the true profile is the
-//   cap convolved with a lobe of comparable width.
+//   D(n; alpha') = 1 / (pi alpha'^2) reproduces. Off axis its error against the exact cap
+//   integral of the same BRDF (reference/disk_light.hpp) grows as r falls (docs/sun.md, section
+//   3): below r ~ 0.2 the lobe is narrower than the sun and the shape of the highlight (a flat
+//   disk seen obliquely) is beyond one widened lobe. Karis's representative point (Real Shading
+//   in Unreal Engine 4, 2013) with the same normalisation is worse at every roughness: it keeps
+//   the peak over the whole cap, while the true profile is the cap convolved with a lobe of
+//   comparable width.
 //
 // ---- Domains, clamps and NaN ------------------------------------------------------------------
 //   Cosines are clamped to [0, 1] (NaN -> 0: no light), roughness and metallic to [0, 1]

@@ -157,6 +157,57 @@ template <class T, int B> struct sh_auto_window_result {
                                ///< a non-finite coefficient or max_width (then width is NaN)
 };
 
+namespace detail {
+template <class T> IBL_FUNC T sh_min3(const vec3<T>& v) noexcept {
+    return v.x < v.y ? (v.x < v.z ? v.x : v.z) : (v.y < v.z ? v.y : v.z);
+}
+
+/// Every coefficient and max_width finite.
+template <class T, int B> IBL_FUNC bool sh_window_inputs_finite(const sh_coeffs<T, B>& radiance, double max_width) noexcept {
+    bool finite = is_finite(max_width);
+    for (int k = 0; k < B * B; ++k)
+        finite = finite && is_finite(radiance.c[k].x) && is_finite(radiance.c[k].y) && is_finite(radiance.c[k].z);
+    return finite;
+}
+
+/// max_width clamped to [1, 2^20], iterations to [0, 64].
+IBL_FUNC sh_auto_window_options sh_window_options_clamped(const sh_auto_window_options& options_in) noexcept {
+    sh_auto_window_options options = options_in;
+    options.max_width = options.max_width < 1.0 ? 1.0 : (options.max_width > 0x1p20 ? 0x1p20 : options.max_width);
+    options.iterations = options.iterations < 0 ? 0 : (options.iterations > 64 ? 64 : options.iterations);
+    return options;
+}
+
+/// log W of the widest window in [1, max_width] found to keep the minimum irradiance >= 0, by
+/// bisection on log W (invariant: the minimum at exp(lo) >= 0, at exp(hi) < 0 or untested hi);
+/// min_lo enters as the minimum at W = 1 (>= 0) and leaves as the minimum at the returned width.
+template <class T, int B>
+IBL_FUNC T sh_window_log_width(const sh_coeffs<T, B>& radiance, const sh_auto_window_options& options, vec3<T>& min_lo) noexcept {
+    using std::exp;
+    using std::log;
+    auto min_at = [&](T width) {
+        return sh_min_irradiance(sh_apply_window(radiance, options.kind, width), options.samples).value;
+    };
+    T lo = T(0), hi = T(log(options.max_width));
+    const vec3<T> min_hi = min_at(exp(hi));
+    if (sh_min3(min_hi) >= T(0)) {
+        min_lo = min_hi;
+        return hi;
+    }
+    for (int it = 0; it < options.iterations; ++it) {
+        const T mid = T(0.5) * (lo + hi);
+        const vec3<T> m = min_at(exp(mid));
+        if (sh_min3(m) >= T(0)) {
+            lo = mid;
+            min_lo = m;
+        } else {
+            hi = mid;
+        }
+    }
+    return lo;
+}
+} // namespace detail
+
 /// The weakest window of options.kind keeping the irradiance non-negative in every channel.
 /// Device-callable, so it never throws: a non-finite coefficient or a non-finite max_width gives
 /// ok = false, width = NaN and the input unchanged (no search); max_width is clamped to
@@ -165,66 +216,18 @@ template <class T, int B>
 IBL_FUNC sh_auto_window_result<T, B> sh_auto_window(const sh_coeffs<T, B>& radiance,
                                                      const sh_auto_window_options& options_in = {}) noexcept {
     using std::exp;
-    using std::log;
-    sh_auto_window_result<T, B> r;
-    bool finite = is_finite(options_in.max_width);
-    for (int k = 0; k < B * B; ++k)
-        finite = finite && is_finite(radiance.c[k].x) && is_finite(radiance.c[k].y) && is_finite(radiance.c[k].z);
-    if (!finite) {
+    if (!detail::sh_window_inputs_finite(radiance, options_in.max_width)) {
         const T nan = std::numeric_limits<T>::quiet_NaN();
-        r.radiance = radiance;
-        r.width = nan;
-        r.min_before = vec3<T>(nan);
-        r.min_after = vec3<T>(nan);
-        r.ok = false;
-        return r;
+        return {radiance, nan, vec3<T>(nan), vec3<T>(nan), false};
     }
-    sh_auto_window_options options = options_in;
-    options.max_width = options.max_width < 1.0 ? 1.0 : (options.max_width > 0x1p20 ? 0x1p20 : options.max_width);
-    options.iterations = options.iterations < 0 ? 0 : (options.iterations > 64 ? 64 : options.iterations);
-    auto min3 = [](const vec3<T>& v) { return v.x < v.y ? (v.x < v.z ? v.x : v.z) : (v.y < v.z ? v.y : v.z); };
-    auto min_at = [&](T width) {
-        return sh_min_irradiance(sh_apply_window(radiance, options.kind, width), options.samples).value;
-    };
-    r.min_before = sh_min_irradiance(radiance, options.samples).value;
-    if (min3(r.min_before) >= T(0)) {
-        r.radiance = radiance;
-        r.width = std::numeric_limits<T>::infinity();
-        r.min_after = r.min_before;
-        r.ok = true;
-        return r;
-    }
-    // invariant: min_at(exp(lo)) >= 0 (lo = log 1: band 0 only), min_at(exp(hi)) < 0 (or untested hi)
-    T lo = T(0), hi = T(log(options.max_width));
-    vec3<T> min_lo = min_at(T(1));
-    if (min3(min_lo) < T(0)) { // negative mean radiance: no window can help
-        r.radiance = sh_apply_window(radiance, options.kind, T(1));
-        r.width = T(1);
-        r.min_after = min_lo;
-        r.ok = false;
-        return r;
-    }
-    const vec3<T> min_hi = min_at(exp(hi));
-    if (min3(min_hi) >= T(0)) {
-        lo = hi;
-        min_lo = min_hi;
-    } else {
-        for (int it = 0; it < options.iterations; ++it) {
-            const T mid = T(0.5) * (lo + hi);
-            const vec3<T> m = min_at(exp(mid));
-            if (min3(m) >= T(0)) {
-                lo = mid;
-                min_lo = m;
-            } else {
-                hi = mid;
-            }
-        }
-    }
-    r.width = exp(lo);
-    r.radiance = sh_apply_window(radiance, options.kind, r.width);
-    r.min_after = min_lo;
-    r.ok = true;
-    return r;
+    const sh_auto_window_options options = detail::sh_window_options_clamped(options_in);
+    const vec3<T> min_before = sh_min_irradiance(radiance, options.samples).value;
+    if (detail::sh_min3(min_before) >= T(0)) return {radiance, std::numeric_limits<T>::infinity(), min_before, min_before, true};
+    vec3<T> min_lo = sh_min_irradiance(sh_apply_window(radiance, options.kind, T(1)), options.samples).value;
+    if (detail::sh_min3(min_lo) < T(0)) // negative mean radiance: no window can help
+        return {sh_apply_window(radiance, options.kind, T(1)), T(1), min_before, min_lo, false};
+    const T width = exp(detail::sh_window_log_width(radiance, options, min_lo));
+    return {sh_apply_window(radiance, options.kind, width), width, min_before, min_lo, true};
 }
 
 } // namespace ibl
