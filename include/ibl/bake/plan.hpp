@@ -9,7 +9,7 @@
 //   converged products of the same layout (a bake with many samples, full resolution, exact DFG,
 //   brute-force irradiance). It is NOT the error of the split-sum approximation against the true
 //   integral (reference/radiance.hpp): that error (tens of per cent under a sun, see
-//   examples/split_sum_error.cpp) belongs to the shading model, and no product plan can reduce it.
+//   research/split_sum_error.cpp) belongs to the shading model, and no product plan can reduce it.
 //   Per product (each must meet the target on its own measure):
 //     specular  normalised RMSE (RMSE / RMS of the reference) of each used prefiltered level;
 //     diffuse   RMS(E_product - E) / RMS(E) over normals (irradiance, E = brute-force cosine integral);
@@ -47,7 +47,7 @@
 //   size_v << v over the needed levels, capped by plan_settings::max_base_size (the source's size).
 //
 // ---- Specular: samples and read mode per level (filtered importance sampling) ---------------------
-//   Measured where it is used (tools/ibl-bake/plan_measure.cpp `prefilter`): the chain layouts
+//   Measured where it is used (research/plan_measure.cpp `prefilter`): the chain layouts
 //   the plan produces for a 256 source (6 virtual levels, linear policy, virtual base 256 when
 //   r = 0.2 is read, else 128; level v at face size base >> v; source baked at the base size, 4 x 4
 //   sub-samples), default sky + 1-degree sun of 3e4 (the hardest case we ship). Error of a level:

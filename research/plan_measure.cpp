@@ -136,7 +136,7 @@ void measure_sh() {
     };
     row("default sky + sun", ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), 64, 16, ibl::thread_executor{}, 1));
     for (const char* file : {"courtyard.exr", "studio.exr"}) {
-        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(std::string(IBL_PLAN_DATA_DIR) + "/" + file);
+        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(std::string(IBL_RESEARCH_DATA_DIR) + "/" + file);
         const ibl::latlong<float> ll(img.width, img.height, std::span<const float>(img.rgb), 1);
         row(file, ibl::latlong_to_cubemap(ll, 64, 4, ibl::thread_executor{}, 1));
     }
