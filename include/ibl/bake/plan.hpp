@@ -411,17 +411,10 @@ inline void check_plan_settings(const char* fn, const plan_settings& set) {
 }
 } // namespace detail
 
-/// The plan for a scene (the rules of the header).
-inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_settings& set = {}) {
-    detail::check_plan_settings("make_bake_plan", set);
-    bake_plan p;
-    const scene_description s = validate_scene(scene_in, p.warnings);
-    p.scene = s.name;
-    p.error_target = s.error_target;
-    p.diffuse_error_target = s.diffuse_error_target;
+namespace detail {
+/// Specular step 1: the virtual levels some used roughness reads (floor(lod(lo)) .. ceil(lod(hi))).
+inline std::vector<bool> needed_levels(const scene_description& s, const plan_settings& set) {
     const int L = set.levels;
-
-    // Specular: needed virtual levels.
     std::vector<bool> needed(std::size_t(L), false);
     for (const auto& m : s.materials)
         for (const auto& r : m.roughness) {
@@ -429,96 +422,128 @@ inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_se
             const int v0 = std::clamp(int(std::floor(a)), 0, L - 1), v1 = std::clamp(int(std::ceil(b)), 0, L - 1);
             for (int v = v0; v <= v1; ++v) needed[std::size_t(v)] = true;
         }
-    int first = 0, last = L - 1;
-    while (!needed[std::size_t(first)]) ++first;
-    while (!needed[std::size_t(last)]) --last;
-    specular_plan& sp = p.specular;
-    sp.enabled = true;
-    sp.policy = set.policy;
-    sp.virtual_levels = L;
-    sp.first_level = first;
+    return needed;
+}
+
+/// Specular step 2: the virtual base size, the largest size_v << v over the needed levels
+/// first .. last (texel rule and screen cap), capped by max_base_size.
+inline int virtual_base_size(const scene_description& s, const plan_settings& set, const std::vector<bool>& needed,
+                             int first, int last) {
     const int screen_cap = std::max(1, s.max_reflection_pixels / 2);
     int base = 1;
     for (int v = first; v <= last; ++v) {
         if (!needed[std::size_t(v)]) continue;
-        const double r = set.policy.roughness(double(v), L);
+        const double r = set.policy.roughness(double(v), set.levels);
         const int n = face_size_for_roughness(r, set.texel_fraction, std::min(screen_cap, set.max_base_size));
         base = std::max(base, int(std::min<long long>((long long)n << v, set.max_base_size))); // n <= 2^16, v < 17
     }
-    base = std::min(base, set.max_base_size);
-    sp.virtual_base_size = base;
+    return std::min(base, set.max_base_size);
+}
+
+/// Specular step 3: the samples and read mode of one needed level v >= 1 (the cheapest choice
+/// within target / margin); a warning when the table reaches no such choice. Returns the smallest
+/// product target the level can reach then (expected error x margin), else 0.
+inline double plan_needed_level(specular_level_plan& lp, const scene_description& s, std::vector<std::string>& warnings) {
+    const double margin = prefilter_product_margin(lp.roughness), level_target = s.error_target / margin;
+    const prefilter_choice c = choose_prefilter(lp.roughness, level_target, s.limits.max_samples);
+    lp.samples = c.samples;
+    lp.trilinear = c.trilinear;
+    lp.expected_error = c.expected_error;
+    if (c.met) return 0.0;
+    warnings.push_back("specular level " + std::to_string(lp.level) + " (r=" + fmt_num(lp.roughness) + "): target " +
+                       fmt_num(s.error_target) + " needs level error <= " + fmt_num(level_target) + " (margin " +
+                       fmt_num(margin) + "), below the reachable ~" + fmt_num(c.expected_error) + " (" +
+                       std::to_string(c.samples) + (c.trilinear ? " trilinear" : " nearest") + " samples, sky + sun)");
+    return c.expected_error * margin;
+}
+
+/// Specular: the stored levels (the sharpest and the roughest needed and every level between),
+/// their sizes, samples and read modes.
+inline specular_plan plan_specular(const scene_description& s, const plan_settings& set, std::vector<std::string>& warnings) {
+    const int L = set.levels;
+    const std::vector<bool> needed = needed_levels(s, set);
+    int first = 0, last = L - 1;
+    while (!needed[std::size_t(first)]) ++first;
+    while (!needed[std::size_t(last)]) --last;
+    specular_plan sp;
+    sp.enabled = true;
+    sp.policy = set.policy;
+    sp.virtual_levels = L;
+    sp.first_level = first;
+    sp.virtual_base_size = virtual_base_size(s, set, needed, first, last);
     double worst_reachable = 0.0;
     bool all_tri = true;
     for (int v = first; v <= last; ++v) {
         specular_level_plan lp;
         lp.level = v;
-        lp.size = std::max(1, base >> v);
+        lp.size = std::max(1, sp.virtual_base_size >> v);
         lp.roughness = set.policy.roughness(double(v), L);
         lp.needed = needed[std::size_t(v)];
-        if (v == 0) {
-            lp.samples = 0; // the mirror level: a copy of the source
-        } else if (lp.needed) {
-            const double margin = prefilter_product_margin(lp.roughness), level_target = s.error_target / margin;
-            const prefilter_choice c = choose_prefilter(lp.roughness, level_target, s.limits.max_samples);
-            lp.samples = c.samples;
-            lp.trilinear = c.trilinear;
-            lp.expected_error = c.expected_error;
-            if (!c.met) {
-                p.warnings.push_back("specular level " + std::to_string(v) + " (r=" + detail::fmt_num(lp.roughness) + "): target " +
-                                     detail::fmt_num(s.error_target) + " needs level error <= " + detail::fmt_num(level_target) +
-                                     " (margin " + detail::fmt_num(margin) + "), below the reachable ~" +
-                                     detail::fmt_num(c.expected_error) + " (" + std::to_string(c.samples) +
-                                     (c.trilinear ? " trilinear" : " nearest") + " samples, sky + sun)");
-                worst_reachable = std::max(worst_reachable, c.expected_error * margin);
-            }
-        } else {
-            lp.samples = set.filler_samples;
-        }
+        if (v == 0) lp.samples = 0; // the mirror level: a copy of the source
+        else if (lp.needed) worst_reachable = std::max(worst_reachable, plan_needed_level(lp, s, warnings));
+        else lp.samples = set.filler_samples;
         if (v > 0) all_tri = all_tri && lp.trilinear;
         sp.levels.push_back(lp);
     }
     sp.trilinear = all_tri && sp.levels.size() > 1;
     if (worst_reachable > 0.0)
-        p.warnings.push_back("specular: the smallest reachable target for this scene is ~" +
-                             detail::fmt_num(worst_reachable) +
-                             " (filtered IS on a sky with a sun; the full bake is not better)");
-    p.source_size = base;
+        warnings.push_back("specular: the smallest reachable target for this scene is ~" + fmt_num(worst_reachable) +
+                           " (filtered IS on a sky with a sun; the full bake is not better)");
+    return sp;
+}
 
-    // Diffuse.
+/// Diffuse: none (no diffuse IBL or only bare metals), 2- or 3-band SH, or an irradiance map.
+inline diffuse_plan plan_diffuse(const scene_description& s, std::vector<std::string>& warnings) {
+    diffuse_plan d;
     bool any_dielectric = false;
     for (const auto& m : s.materials) any_dielectric = any_dielectric || m.metallic < 1.0;
-    if (s.diffuse_ibl && any_dielectric) {
-        diffuse_plan& d = p.diffuse;
-        const double t = s.diffuse_error_target;
-        if (t >= sh2_irradiance_error || s.limits.max_sh_bands == 2) {
-            d.kind = diffuse_product::sh;
-            d.sh_bands = 2;
-            d.expected_error = sh2_irradiance_error;
-            if (t < sh2_irradiance_error)
-                p.warnings.push_back("diffuse: max_sh_bands = 2 gives ~" + detail::fmt_num(sh2_irradiance_error) + " > target " +
-                                     detail::fmt_num(t));
-        } else if (t >= sh3_irradiance_error) {
-            d.kind = diffuse_product::sh;
-            d.sh_bands = 3;
-            d.expected_error = sh3_irradiance_error;
-        } else {
-            d.kind = diffuse_product::irradiance_map;
-            d.map_size = 32;
-            d.map_samples = 1024;
-            d.expected_error = 0.0; // not measured here: bounded by the map's resolution and samples
-        }
+    if (!s.diffuse_ibl || !any_dielectric) return d; // kind none
+    const double t = s.diffuse_error_target;
+    if (t >= sh2_irradiance_error || s.limits.max_sh_bands == 2) {
+        d.kind = diffuse_product::sh;
+        d.sh_bands = 2;
+        d.expected_error = sh2_irradiance_error;
+        if (t < sh2_irradiance_error)
+            warnings.push_back("diffuse: max_sh_bands = 2 gives ~" + fmt_num(sh2_irradiance_error) + " > target " + fmt_num(t));
+    } else if (t >= sh3_irradiance_error) {
+        d.kind = diffuse_product::sh;
+        d.sh_bands = 3;
+        d.expected_error = sh3_irradiance_error;
     } else {
-        p.diffuse.kind = diffuse_product::none;
+        d.kind = diffuse_product::irradiance_map;
+        d.map_size = 32;
+        d.map_samples = 1024;
+        d.expected_error = 0.0; // not measured here: bounded by the map's resolution and samples
     }
+    return d;
+}
 
-    // DFG.
-    p.dfg.enabled = true;
-    p.dfg.size = std::min(dfg_size_for(s.error_target), s.limits.max_dfg_size);
-    p.dfg.channels = s.multiscatter ? 3 : 2;
-    p.dfg.expected_error = dfg_error_at(p.dfg.size);
-    if (p.dfg.expected_error > s.error_target / 8.0)
-        p.warnings.push_back("dfg: size " + std::to_string(p.dfg.size) + " errs by ~" + detail::fmt_num(p.dfg.expected_error) +
-                             " > target / 8");
+/// DFG: the smallest tabulated size within target / 8, capped by the platform's limit.
+inline dfg_plan plan_dfg(const scene_description& s, std::vector<std::string>& warnings) {
+    dfg_plan d;
+    d.enabled = true;
+    d.size = std::min(dfg_size_for(s.error_target), s.limits.max_dfg_size);
+    d.channels = s.multiscatter ? 3 : 2;
+    d.expected_error = dfg_error_at(d.size);
+    if (d.expected_error > s.error_target / 8.0)
+        warnings.push_back("dfg: size " + std::to_string(d.size) + " errs by ~" + fmt_num(d.expected_error) + " > target / 8");
+    return d;
+}
+} // namespace detail
+
+/// The plan for a scene (the rules of the header): the scene checked, then specular, diffuse and
+/// DFG planned in that order (their warnings follow the scene's).
+inline bake_plan make_bake_plan(const scene_description& scene_in, const plan_settings& set = {}) {
+    detail::check_plan_settings("make_bake_plan", set);
+    bake_plan p;
+    const scene_description s = validate_scene(scene_in, p.warnings);
+    p.scene = s.name;
+    p.error_target = s.error_target;
+    p.diffuse_error_target = s.diffuse_error_target;
+    p.specular = detail::plan_specular(s, set, p.warnings);
+    p.source_size = p.specular.virtual_base_size;
+    p.diffuse = detail::plan_diffuse(s, p.warnings);
+    p.dfg = detail::plan_dfg(s, p.warnings);
     return p;
 }
 
