@@ -63,8 +63,8 @@ namespace {
 using dvec3 = ibl::vec3<double>;
 using model = ibl::ggx_height_correlated;
 
-/// What the header holds: the grids the measurements ran on and the measured values, each as the
-/// decimal text written (3 decimals; the DFG errors 3 significant digits), which --check compares.
+/// What the header holds: the grids the measurements ran on and the measured values (written with 3
+/// decimals, the DFG errors with 3 significant digits: the text --check compares).
 struct plan_tables {
     std::array<std::uint32_t, 5> dfg_sizes{16u, 32u, 64u, 128u, 256u};
     std::array<double, 5> dfg_error{};
@@ -87,8 +87,8 @@ std::array<double, 5> measure_dfg() {
     });
     std::array<double, 5> inner{};
     const std::array<std::uint32_t, 5> sizes = plan_tables{}.dfg_sizes;
-    for (std::size_t s = 0; s < sizes.size(); ++s) {
-        const std::uint32_t n = sizes[s];
+    for (std::size_t row = 0; row < sizes.size(); ++row) {
+        const std::uint32_t n = sizes[row];
         const ibl::dfg_lut lut = ibl::make_dfg_lut_exact<model>(n, 2);
         double mx = 0, ss = 0, mx_inner = 0;
         for (std::size_t k = 0; k < ref.size(); ++k) {
@@ -99,7 +99,7 @@ std::array<double, 5> measure_dfg() {
             if (xs[k % g] >= 0.1) mx_inner = std::max(mx_inner, d);
         }
         std::printf("%6u %12.3e %12.3e %14.3e\n", n, mx, std::sqrt(ss / double(ref.size())), mx_inner);
-        inner[s] = mx_inner;
+        inner[row] = mx_inner;
     }
     return inner;
 }
@@ -194,8 +194,6 @@ double nrmse_at(const std::vector<dvec3>& a, const std::vector<dvec3>& ref) {
 void measure_prefilter(plan_tables& out) {
     constexpr int levels = 6;
     const std::vector<std::uint32_t> ns(out.prefilter_n.begin(), out.prefilter_n.end());
-    for (int v = 1; v < levels; ++v)
-        for (std::size_t i = 0; i < ns.size(); ++i) out.nearest[v - 1][i] = out.trilinear[v - 1][i] = 0.0;
     const auto sky = ibl::make_default_sky<double>();
     const ibl::roughness_mip_policy policy = ibl::roughness_mip_policy::linear();
     ibl::thread_executor ex{};
@@ -335,7 +333,8 @@ bool write_header(const std::string& path, const plan_tables& t) {
 //              cosine integral at 1536 normals; the worst of the three.
 //   dfg        ggx_height_correlated: exact N^2 tables read bilinearly (clamp-to-edge) against
 //              dfg_exact at 257^2 off-grid points with n.v >= 0.1; the largest |dA|, |dB|.
-// The errors are deterministic (the same on any machine). One sky is one sky: a scene lit
+// The errors do not depend on timing or threads: two runs of one build write the same header
+// (another compiler may move a value at a rounding edge by 0.001). One sky is one sky: a scene lit
 // otherwise may need other margins (docs/scene-format.md).
 // Recorded, not measured by plan_measure (the writer carries them over from the header it
 // replaces; edit them here, with their source):

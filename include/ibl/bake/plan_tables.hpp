@@ -28,7 +28,8 @@
 //              cosine integral at 1536 normals; the worst of the three.
 //   dfg        ggx_height_correlated: exact N^2 tables read bilinearly (clamp-to-edge) against
 //              dfg_exact at 257^2 off-grid points with n.v >= 0.1; the largest |dA|, |dB|.
-// The errors are deterministic (the same on any machine). One sky is one sky: a scene lit
+// The errors do not depend on timing or threads: two runs of one build write the same header
+// (another compiler may move a value at a rounding edge by 0.001). One sky is one sky: a scene lit
 // otherwise may need other margins (docs/scene-format.md).
 // Recorded, not measured by plan_measure (the writer carries them over from the header it
 // replaces; edit them here, with their source):
