@@ -3,7 +3,7 @@
 //     sky + sun (ibl-bake's default bake: filtered IS, trilinear, 512 spp at level 1 doubled per
 //     level) at a random direction and roughness in [0.25, 1]; counters: rel_rmse_worst = the
 //     largest relative RMSE of luminance over r = 0.25, 0.30, ..., 1 against reference_ld_sky at
-//     64 texel-centre directions + the 5 x 5 block about the sun (examples/lookup_error.cpp does
+//     64 texel-centre directions + the 5 x 5 block about the sun (research/lookup_error.cpp does
 //     the full study), taps = bilinear reads per lookup.
 //     schemes: 0 textbook (lod linear), 1 default (log r, geometric), 2 Catmull-Rom in lod.
 //   BM_dfg_lookup/<layout>: one DFG table lookup (128^2, ggx_height_correlated) at a random

@@ -4,7 +4,7 @@
 //     (ibl-bake's default bake, G1 weight for the variants that say so). Counters:
 //       rel_rmse = relative RMSE of luminance against reference_radiance (MIS, 2^14 samples) over
 //                  48 points (r in {0.3, 0.5, 0.8} x n.v in {0.25, 0.5, 1} x 16 random normals / views;
-//                  computed once in the fixture, not timed); examples/runtime_error.cpp does the
+//                  computed once in the fixture, not timed); research/runtime_error.cpp does the
 //                  full study on the HDRIs.
 //       taps     = chain textureLod reads per evaluation (the LUT tap comes on top where used).
 //     variants: 0 split sum (n.l chain), 1 split sum (G1 chain), 2 Frostbite dominant direction

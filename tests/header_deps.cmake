@@ -9,7 +9,9 @@
 #   ibl/sh.hpp               core/ sh/ env/cube_geometry.hpp (no batch/ or prefilter code)
 #   runtime/shade.hpp        core/ brdf/           (takes products as values, reads no table code)
 #   runtime/lookup.hpp       core/ brdf/ env/ runtime/ (no integrator, no table builder)
-#   bake/plan.hpp            core/ runtime/roughness_mip.hpp (the plan is arithmetic, no integrator)
+#   bake/plan.hpp            core/ runtime/roughness_mip.hpp bake/plan_tables.hpp (the plan is
+#                            arithmetic on its measured data, no integrator)
+#   bake/plan_tables.hpp     core/ (data only: the tables research/plan_measure.cpp writes)
 #   batch/**.hpp             core/ brdf/ sampling/ env/ batch/ (kernels; never bake/, which calls them)
 #
 # Research (the top-level research/ folder: studies, baselines, tuning programs) is never
@@ -36,7 +38,8 @@ set(rules
     "runtime/lookup.hpp|core/ brdf/ env/ runtime/"
     "bake.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/"
     "bake/*.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/"
-    "bake/plan.hpp|core/ runtime/roughness_mip.hpp"
+    "bake/plan.hpp|core/ runtime/roughness_mip.hpp bake/plan_tables.hpp"
+    "bake/plan_tables.hpp|core/"
     "reference.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/ reference/"
     "reference/*.hpp|core/ brdf/ sampling/ env/ sh/ batch/ runtime/ bake/ reference/")
 

@@ -161,7 +161,7 @@ TEST_CASE("dfg layout: remap inverse, texel centres return the texel, uniform = 
 
 TEST_CASE("dfg lookup: the remapped layout at 128^2 meets 1e-3 for r >= 0.05 (the uniform table does not)") {
     // Grid: n.v uniform and quadratic at 97 points each (both ends), r in [0.05, 1] at 40 points;
-    // exact values by the converged quadrature (1e-6). The measured errors (examples/lookup_error):
+    // exact values by the converged quadrature (1e-6). The measured errors (research/lookup_error):
     // default 5.7e-4 (f32), 5.5e-4 (f16); uniform 8.5e-2 at n.v = 0 (its half-texel clamp).
     const ibl::dfg_error_grid g = ibl::dfg_error_grid::dense(97, 40, 0.05);
     const std::vector<ibl::vec2<double>> exact = ibl::dfg_exact_grid<ibl::ggx_height_correlated>(g);

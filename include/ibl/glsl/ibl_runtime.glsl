@@ -13,7 +13,7 @@
 // (n.z >= 0 ? 1 : -1) here (they differ only at n.z = -0); ibl_specular_fis takes at most
 // IBL_FIS_MAX_TAPS taps (the C++ has no cap). The bent-normal reading of the occlusion table has
 // no C++ function: it is the expression docs/occlusion.md measures as "lobe LUT, bent"
-// (examples/occlusion_error.cpp). The table is read by the texture unit's trilinear filter, not
+// (research/occlusion_error.cpp). The table is read by the texture unit's trilinear filter, not
 // by the C++'s float weights (docs/shaders.md bounds the difference).
 
 #ifndef IBL_GLSL_RUNTIME

@@ -34,7 +34,7 @@
 // angular half-width of about 2 alpha, and reference_ld_texel_level picks the coarsest level
 // whose texel (pi / (2 n) radians at the face centre) is at most alpha / 2 (ideally 4 or more
 // texels per half-width), level 0 if none is. Comparing two levels bounds its error (the example
-// examples/lookup_error.cpp prints that check).
+// research/lookup_error.cpp prints that check).
 //
 // DFG (dfg_lookup_error). Over a grid of (n.v, r) points, max and RMS of |A - A_exact| and
 // |B - B_exact| of dfg_lookup(lut, n.v, r) (the table's own layout) against exact values (dfg_exact_grid: the

@@ -3,7 +3,7 @@
 //   Lo_s(n, v) = integral f_s(v, l) L(l) (n.l) dl,   f_s = D(h) V(v, l) F(v.h)   (GGX, Smith)
 // from a prefiltered chain (runtime/lookup.hpp) and small tables, beyond the split sum's LD(R) (F0 A + F90 B).
 // docs/runtime.md measures every variant against the full integral (reference_radiance) and
-// names the default; examples/runtime_error.cpp produces its tables.
+// names the default; research/runtime_error.cpp produces its tables.
 //
 // ---- Dominant direction (S. Lagarde, C. de Rousiers, "Moving Frostbite to PBR", 2014, 4.9.3) ----
 //   The GGX lobe f_s (n.l) is not centred on R = reflect(-v, n): masking and the n.l factor pull

@@ -1,6 +1,9 @@
-// examples/lookup_error.cpp — what a renderer gets: the error of the runtime lookups (ibl/runtime/lookup.hpp)
+// research/lookup_error.cpp — what a renderer gets: the error of the runtime lookups (ibl/runtime/lookup.hpp)
 // at roughness between the baked levels and at n.v, r between the DFG table's texels, measured by
-// reference/lookup_error.hpp against exact references. The tables of docs/lookup.md come from here.
+// reference/lookup_error.hpp against exact references.
+// Produces: every table of docs/lookup.md (pasted from its output). Regenerate with
+//   cmake --preset release && cmake --build --preset release --target lookup_error
+//   ./build/release/research/lookup_error [dfg|spec|spec-quick]    (spec: about 6 minutes on 2 cores)
 //
 //   lookup_error            both parts
 //   lookup_error dfg        DFG table sizes x layouts x storage (float / half)
@@ -40,7 +43,7 @@
 #include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/runtime/lookup.hpp>
 
-#if defined(IBL_EXAMPLES_DATA_DIR)
+#if defined(IBL_RESEARCH_DATA_DIR)
 #include "image_io.hpp"
 #endif
 
@@ -195,9 +198,9 @@ void run_spec(bool quick) {
         };
         envs.push_back(std::move(e));
     }
-#if defined(IBL_EXAMPLES_DATA_DIR)
+#if defined(IBL_RESEARCH_DATA_DIR)
     for (const char* file : {"courtyard.exr", "studio.exr"}) {
-        const std::string path = std::string(IBL_EXAMPLES_DATA_DIR) + "/" + file;
+        const std::string path = std::string(IBL_RESEARCH_DATA_DIR) + "/" + file;
         try {
             const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(path, {});
             ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);

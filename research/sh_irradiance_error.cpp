@@ -1,4 +1,4 @@
-// sh_irradiance_error — how wrong is 3-band SH irradiance (Ramamoorthi & Hanrahan 2001), measured
+// research/sh_irradiance_error.cpp — how wrong is 3-band SH irradiance (Ramamoorthi & Hanrahan 2001), measured
 // against brute-force cosine-weighted integration of the same cubemap?
 //
 //   reference  E(n) = sum over every texel t of L_t max(0, n . d_t) Omega_t   (exact Omega_t, double)
@@ -10,7 +10,10 @@
 // error, and the smallest irradiance (ringing makes it negative around suns), without and with
 // the automatic Hanning window.
 //
-// usage: sh_irradiance_error [latlong.exr|.hdr ...]    (default: tests/data/courtyard.exr)
+// Produces: no docs table (a study kept for comparison; the plan's SH figures come from
+// research/plan_measure.cpp `sh`). Run with
+//   cmake --preset release && cmake --build --preset release --target sh_irradiance_error
+//   ./build/release/research/sh_irradiance_error [latlong.exr|.hdr ...]    (default: tests/data/courtyard.exr)
 #include <ibl/env.hpp>
 #include <ibl/sh.hpp>
 
@@ -103,7 +106,7 @@ int main(int argc, char** argv) {
     }
     std::vector<std::string> files;
     for (int i = 1; i < argc; ++i) files.emplace_back(argv[i]);
-    if (files.empty()) files.emplace_back(std::string(IBL_EXAMPLES_DATA_DIR) + "/courtyard.exr");
+    if (files.empty()) files.emplace_back(std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr");
     for (const auto& file : files) {
         try {
             const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file);

@@ -1,5 +1,5 @@
 #pragma once
-// examples/study_envs.hpp — what the runtime studies (runtime_error, occlusion_error) share: the
+// research/study_envs.hpp — what the runtime studies (runtime_error, occlusion_error) share: the
 // deterministic shading points and the environments (the built-in sky + sun and the HDRIs of
 // tests/data), each with the 512^2 source cube the products are baked from and the MIS
 // environment distribution of its reference.
@@ -19,7 +19,7 @@
 #include <ibl/reference/env_importance.hpp>
 #include <ibl/reference/radiance.hpp>
 
-#if defined(IBL_EXAMPLES_DATA_DIR)
+#if defined(IBL_RESEARCH_DATA_DIR)
 #include "image_io.hpp"
 #endif
 
@@ -50,9 +50,9 @@ template <class Run> void for_each_environment(Run&& run) {
         const ibl::cube_env_distribution dist = ibl::make_cube_env_distribution<double>(sky, 128, 4);
         run(std::string("sky + sun"), sky, src, dist);
     }
-#if defined(IBL_EXAMPLES_DATA_DIR)
+#if defined(IBL_RESEARCH_DATA_DIR)
     for (const char* file : {"courtyard.exr", "studio.exr"}) {
-        const std::string path = std::string(IBL_EXAMPLES_DATA_DIR) + "/" + file;
+        const std::string path = std::string(IBL_RESEARCH_DATA_DIR) + "/" + file;
         try {
             const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(path, {});
             ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);

@@ -1,4 +1,4 @@
-// foundation_table — the library's first report: the directional albedo E(n.v, r) of the two
+// research/foundation_table.cpp — the library's first report: the directional albedo E(n.v, r) of the two
 // shipped GGX models (Fresnel = 1), estimated the way the literature's DFG shaders do it
 // (Hammersley + GGX NDF importance sampling, 1024 samples) next to a converged estimate
 // (2^20 samples, double), with the error and the time of each.
@@ -6,8 +6,11 @@
 //   E(mu, r) = integral over the hemisphere of f(v, l) n.l d(omega_l),  f = D V (F = 1)
 //   estimator: (1/N) sum_i M::sample_weight(n.v, n.l_i, n.h_i, v.h_i, r),  h_i ~ D(h) n.h
 //
-// A study kept for comparison: the bake tool (tools/ibl-bake, run by scripts/main.sh) reports the
-// DFG table's exact quadrature instead.
+// A baseline kept for comparison: the bake tool (tools/ibl-bake, run by scripts/main.sh) bakes and
+// reports the DFG table by exact quadrature (bake/dfg_lut.hpp's make_dfg_lut_exact) instead.
+// Produces: no docs table. Run with
+//   cmake --preset release && cmake --build --preset release --target foundation_table
+//   ./build/release/research/foundation_table
 #include <ibl/ibl.hpp>
 
 #include <chrono>

@@ -1,11 +1,14 @@
-// examples/occlusion_error.cpp — specular occlusion against the occluded reference
+// research/occlusion_error.cpp — specular occlusion against the occluded reference
 // (reference/occluded_specular.hpp): the environment is visible only inside a cone of half-angle theta_o
 // about a bent normal b, and the reference integrates f_s L V (n.l) in full (MIS, no split sum).
-// The tables of docs/occlusion.md come from here.
+// Produces: docs/results/occlusion_error.txt, the source of the tables of docs/occlusion.md.
+// Regenerate with
+//   cmake --preset release && cmake --build --preset release --target occlusion_error
+//   ./build/release/research/occlusion_error > docs/results/occlusion_error.txt    (about 2 minutes)
 //
 //   occlusion_error [quick]      quick: 8 points per cell, 2^12 reference samples (a smoke run)
 //
-// Runtime model (the unoccluded part): the split sum as examples/runtime_error.cpp bakes it: a
+// Runtime model (the unoccluded part): the split sum as research/runtime_error.cpp bakes it: a
 // 512^2 source cube prefiltered to a 256^2 x 6-level chain (ibl::prefilter, ld_weight::g1,
 // trilinear reads), make_dfg_lut_exact 128^2, ibl::specular_lookup at R; specular = LD(R) (F0 A +
 // F90 B). Occlusion variants multiply it by a factor k:

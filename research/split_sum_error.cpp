@@ -1,12 +1,16 @@
-// examples/split_sum_error.cpp — how wrong is the split sum? Outgoing radiance of glossy materials
+// research/split_sum_error.cpp — how wrong is the split sum? Outgoing radiance of glossy materials
 // under an environment, by the split-sum product (what a renderer evaluates at run time) against
 // the reference integral without the approximation (reference/radiance.hpp).
+// Produces: no stored table; its output is the source of the split-sum figures quoted in README.md
+// ("off by up to 78%"), docs/ibl-bake.md and docs/scene-format.md. Regenerate with
+//   cmake --preset release && cmake --build --preset release --target split_sum_error
+//   ./build/release/research/split_sum_error [latlong.exr]
 //
 // For each environment (the built-in default sky with its 1-degree sun, and tests/data/courtyard.exr
-// when the example is built with the ibl-bake image reader), each normal / view and each material
+// read with the ibl-bake image reader), each normal / view and each material
 // (r in {0.1, 0.5, 0.9} x {dielectric: base 0.8, F0 0.04; metal: F0 (0.95, 0.64, 0.54), metallic 1}).
-// The reader is linked when CMake builds the ibl_bake_io target (examples/CMakeLists.txt defines
-// IBL_EXAMPLES_DATA_DIR then); a path argument replaces courtyard.exr.
+// The reader is linked by research/CMakeLists.txt (which defines IBL_RESEARCH_DATA_DIR); a path
+// argument replaces courtyard.exr.
 // it prints
 //   reference Lo   = integral (f_d + D V F) L (n.l) dl, MIS of BRDF and environment sampling,
 //                    2^20 samples, with its standard error (from 16 independent randomisations);
@@ -47,7 +51,7 @@
 #include <ibl/sampling/ggx.hpp>
 #include <ibl/runtime/shade.hpp>
 
-#if defined(IBL_EXAMPLES_DATA_DIR)
+#if defined(IBL_RESEARCH_DATA_DIR)
 #include "image_io.hpp"
 #endif
 
@@ -280,8 +284,8 @@ int main(int argc, char** argv) {
     }
     std::printf("\nlargest |rel| (sky): %.2f%%\n\n", 100.0 * std::fabs(worst_sky));
 
-#if defined(IBL_EXAMPLES_DATA_DIR)
-    const std::string path = argc > 1 ? argv[1] : std::string(IBL_EXAMPLES_DATA_DIR) + "/courtyard.exr";
+#if defined(IBL_RESEARCH_DATA_DIR)
+    const std::string path = argc > 1 ? argv[1] : std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr";
     try {
         ibl_bake::read_report report;
         const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(path, {}, &report);

@@ -1,7 +1,12 @@
-// examples/runtime_error.cpp — the runtime approximations of ibl/runtime/specular_models.hpp against the full
+// research/runtime_error.cpp — the runtime approximations of ibl/runtime/specular_models.hpp against the full
 // integral: each variant's specular radiance against ibl::reference_radiance (MIS of the BRDF and
-// the environment, no split sum), over random normals and views at fixed n.v. The tables of
-// docs/runtime.md come from here.
+// the environment, no split sum), over random normals and views at fixed n.v.
+// Produces: docs/results/runtime_error.txt, runtime_error_fit.txt and runtime_error_levels8.txt,
+// the sources of the tables of docs/runtime.md. Regenerate with
+//   cmake --preset release && cmake --build --preset release --target runtime_error
+//   ./build/release/research/runtime_error > docs/results/runtime_error.txt    (38 s on 2 cores)
+//   ./build/release/research/runtime_error fit > docs/results/runtime_error_fit.txt
+//   ./build/release/research/runtime_error levels=8 > docs/results/runtime_error_levels8.txt
 //
 //   runtime_error [quick|explore|fit] [levels=N]
 //     quick: 8 points per cell, 2^13 reference samples (a smoke run); explore: FIS footprint
