@@ -22,7 +22,8 @@
 #include <ibl/env/convert.hpp>
 #include <ibl/reference/env_importance.hpp>
 #include <ibl/bake/lobe_fit.hpp>
-#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/lobe_moments.hpp>
+#include "../research/lobe_moment_baseline.hpp" // make_lobe_lut: the moment-matched baseline
 #include <ibl/reference/lookup_error.hpp>
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/reference/radiance.hpp>

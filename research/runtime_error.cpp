@@ -48,7 +48,8 @@
 #include <ibl/env/latlong.hpp>
 #include <ibl/reference/env_importance.hpp>
 #include <ibl/bake/lobe_fit.hpp>
-#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/lobe_moments.hpp>
+#include "lobe_moment_baseline.hpp"
 #include <ibl/reference/lookup_error.hpp>
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/reference/radiance.hpp>

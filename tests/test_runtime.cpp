@@ -1,5 +1,5 @@
 // tests/test_runtime.cpp — the runtime approximations (ibl/runtime/specular_models.hpp) and the lobe LUT
-// (bake/lobe_lut.hpp): end values of the Frostbite helpers, the G2/G1 ratio against the
+// (bake/lobe_moments.hpp): end values of the Frostbite helpers, the G2/G1 ratio against the
 // model's V and G1, the footprint roughness against the kernel solid angle it inverts, runtime FIS
 // weights against the DFG albedo, exactness of every normalised variant in a constant
 // environment, the lobe moments against dfg_exact and (at n.v = 1) against the G1 LD kernel
@@ -9,7 +9,8 @@
 
 #include <ibl/brdf/model.hpp>
 #include <ibl/bake/dfg.hpp>
-#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/lobe_moments.hpp>
+#include "../research/lobe_moment_baseline.hpp" // make_lobe_lut: the moment-matched baseline
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/runtime/specular_models.hpp>
 

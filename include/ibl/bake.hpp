@@ -8,7 +8,7 @@
 #include "bake/dfg_multiscatter.hpp"
 #include "bake/irradiance.hpp"
 #include "bake/lobe_fit.hpp"
-#include "bake/lobe_lut.hpp"
+#include "bake/lobe_moments.hpp"
 #include "bake/plan.hpp"
 #include "bake/prefilter.hpp"
 #include "bake/sheen.hpp"

@@ -18,7 +18,7 @@
 // matter, so the objective is estimated over the lobe's own visible-normal draws (a midpoint grid
 // of nodes^2 points, weights f (n.l) / pdf_l). A kernel that reaches below the horizon loses
 // that mass from the lobe's support, so the L1 fit trades width against leakage by itself; the
-// first-moment match of bake/lobe_lut.hpp does not see the horizon at all.
+// first-moment match of bake/lobe_moments.hpp does not see the horizon at all.
 // The fit is a Nelder-Mead search from the moment solution, k taps from the fitted k - 1 with the
 // heaviest tap split in two; it is derived from the BRDF alone, nothing is fitted to an environment. Weights summing
 // to 1 keep the white furnace: a constant environment gives exactly (F0 A + F90 B) L.
@@ -41,7 +41,7 @@
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../sampling/ggx.hpp"
-#include "lobe_lut.hpp"
+#include "lobe_moments.hpp"
 #include "prefilter.hpp"
 #include "../runtime/tables.hpp"
 
@@ -110,7 +110,7 @@ struct lobe_tap {
 inline constexpr int lobe_max_taps = 8;
 
 /// The fitted mixture at (n.v, r): taps (count of them), its L1 distance to the lobe, and the L1
-/// distance of the one-tap moment match (bake/lobe_lut.hpp) for comparison.
+/// distance of the one-tap moment match (bake/lobe_moments.hpp) for comparison.
 struct lobe_mixture {
     int count = 0;
     std::array<lobe_tap, lobe_max_taps> taps{};

@@ -31,7 +31,7 @@
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../runtime/specular_occlusion.hpp"
-#include "lobe_lut.hpp"
+#include "lobe_moments.hpp"
 
 namespace ibl {
 

@@ -11,7 +11,7 @@
 //       d = normalize(lerp(n, R, s)),   s = (1 - alpha) (sqrt(1 - alpha) + alpha)   (alpha = r^2)
 //   (dominant_lerp_frostbite), a fit of the lobe's peak that ignores n.v.
 //
-// ---- The lobe LUT (derived here; bake/lobe_lut.hpp builds it) -------------------------------
+// ---- The lobe LUT (derived here; bake/lobe_fit.hpp builds it) -------------------------------
 //   The one-tap model read at (n.v, r) from a four-channel table (A, B, s, r_eff):
 //       Lo_s ~ LD(normalize(lerp(n, R, s)), r_eff) (F0 A + F90 B)
 //   s and r_eff match the first moment of the normalised lobe p(l) = D V (n.l) / E:
@@ -222,7 +222,7 @@ vec3<float> specular_fis(const Chain& chain, const runtime_fis_desc& d, const ve
 // ---- the lobe LUT ------------------------------------------------------------------------------
 
 /// Bilinear lookup with clamp-to-edge of channels 0..3 of a table with members size, channels and
-/// data (bake/lobe_lut.hpp's lobe_lut) at the coordinates of the table's own layout
+/// data (runtime/tables.hpp's lobe_lut) at the coordinates of the table's own layout
 /// (member layout, runtime/dfg_layout.hpp).
 template <class Table> vec4<float> lobe_lut_lookup(const Table& lut, float n_dot_v, float roughness) {
     const vec2<float> st = dfg_lut_coord(n_dot_v, roughness, lut.size, lut.layout);

@@ -3,7 +3,7 @@
 // the lobe LUT, the fitted-taps table and the two-part lobe tables. Each records the conventions it
 // was built in (`layout`, and for the lobe tables the chain's LD `weight`), and the lookups of
 // runtime/lookup.hpp and runtime/specular_models.hpp read them from the table. The builders are in
-// bake/ (bake/dfg_lut.hpp, bake/lobe_lut.hpp, bake/lobe_fit.hpp); a renderer that loads a table
+// bake/ (bake/dfg_lut.hpp, bake/lobe_fit.hpp); a renderer that loads a table
 // from a file fills these structs and needs none of them.
 //
 // Layout of data (float32, interleaved channels, row-major): data[(j * size + i) * channels + c],
