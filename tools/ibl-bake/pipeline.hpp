@@ -29,7 +29,7 @@
 #include <ibl/env/latlong.hpp>
 #include <ibl/bake/dfg_lut.hpp>
 #include <ibl/bake/lobe_fit.hpp>
-#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/lobe_moments.hpp>
 #include <ibl/bake/plan.hpp>
 #include <ibl/sh/basis.hpp>
 #include <ibl/runtime/shade.hpp>

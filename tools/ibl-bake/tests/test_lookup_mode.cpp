@@ -35,7 +35,7 @@
 #include <ibl/bake/dfg_lut.hpp>
 #include <ibl/reference/disk_light.hpp>
 #include <ibl/bake/lobe_fit.hpp>
-#include <ibl/bake/lobe_lut.hpp>
+#include <ibl/bake/lobe_moments.hpp>
 #include <ibl/runtime/lookup.hpp>
 #include <ibl/runtime/specular_models.hpp>
 #include <ibl/sh/convolve.hpp>
