@@ -44,7 +44,7 @@
 #include <ibl/runtime/lookup.hpp>
 
 #if defined(IBL_RESEARCH_DATA_DIR)
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 #endif
 
 namespace {

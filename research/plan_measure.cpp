@@ -37,7 +37,7 @@
 #include <utility>
 #include <vector>
 
-#include "check_texels.hpp"
+#include "stages/check_texels.hpp"
 
 #include <ibl/brdf/model.hpp>
 #include <ibl/core/color.hpp>
@@ -56,7 +56,7 @@
 #include <ibl/sh/project.hpp>
 #include <ibl/sh/window.hpp>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 
 namespace {
 

@@ -17,7 +17,7 @@
 #include <ibl/env.hpp>
 #include <ibl/sh.hpp>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 
 #include <algorithm>
 #include <cmath>

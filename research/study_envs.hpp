@@ -20,7 +20,7 @@
 #include <ibl/reference/radiance.hpp>
 
 #if defined(IBL_RESEARCH_DATA_DIR)
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 #endif
 
 namespace study {

@@ -20,8 +20,8 @@ SAN=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
 
 echo "== building (clang: $($CXX --version | head -1))"
 "$CXX" "${COMMON[@]}" "${SAN[@]}" -fsanitize=fuzzer \
-    "$SRC/fuzz/fuzz_image_readers.cpp" "$SRC/image_io.cpp" "$SRC/ktx2.cpp" "${LIBS[@]}" -o "$OUT/fuzz_image_readers"
-"$CXX" "${COMMON[@]}" "$SRC/fuzz/make_seeds.cpp" "$SRC/image_io.cpp" "$SRC/ktx2.cpp" "${LIBS[@]}" -o "$OUT/make_seeds"
+    "$SRC/fuzz/fuzz_image_readers.cpp" "$SRC/io/image_io.cpp" "$SRC/io/ktx2.cpp" "${LIBS[@]}" -o "$OUT/fuzz_image_readers"
+"$CXX" "${COMMON[@]}" "$SRC/fuzz/make_seeds.cpp" "$SRC/io/image_io.cpp" "$SRC/io/ktx2.cpp" "${LIBS[@]}" -o "$OUT/make_seeds"
 
 echo "== seed corpus"
 "$OUT/make_seeds" "$OUT/seeds"

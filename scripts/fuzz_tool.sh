@@ -17,8 +17,8 @@ FLAGS=(-std=c++20 -g -O1 -fno-omit-frame-pointer -I"$SRC" -I"$ROOT/include"
        -fsanitize=fuzzer,address,undefined -fno-sanitize-recover=undefined)
 
 echo "== building (clang: $($CXX --version | head -1))"
-"$CXX" "${FLAGS[@]}" "$SRC/fuzz/fuzz_scene.cpp" "$SRC/scene_reader.cpp" "$SRC/input_guard.cpp" -o "$OUT/fuzz_scene"
-"$CXX" "${FLAGS[@]}" "$SRC/fuzz/fuzz_options.cpp" "$SRC/bake_options.cpp" -o "$OUT/fuzz_options"
+"$CXX" "${FLAGS[@]}" "$SRC/fuzz/fuzz_scene.cpp" "$SRC/io/scene_reader.cpp" "$SRC/io/input_guard.cpp" -o "$OUT/fuzz_scene"
+"$CXX" "${FLAGS[@]}" "$SRC/fuzz/fuzz_options.cpp" "$SRC/options/bake_options.cpp" -o "$OUT/fuzz_options"
 
 echo "== seeds"
 cp "$ROOT"/examples/scenes/*.json "$OUT/seeds-scene/"

@@ -14,10 +14,10 @@
 #include <string>
 #include <vector>
 
-#include "bake_options.hpp"
-#include "pipeline.hpp"
-#include "lookup.hpp"
-#include "stages.hpp"
+#include "options/bake_options.hpp"
+#include "stages/pipeline.hpp"
+#include "query/lookup.hpp"
+#include "stages/stages.hpp"
 
 int main(int argc, char** argv) {
     using namespace ibl_bake;

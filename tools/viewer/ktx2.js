@@ -1,5 +1,5 @@
 // tools/viewer/ktx2.js — a small reader of the KTX 2.0 cubemaps ibl-bake writes
-// (tools/ibl-bake/ktx2.hpp lists every field): header, level index, uncompressed level data.
+// (tools/ibl-bake/io/ktx2.hpp lists every field): header, level index, uncompressed level data.
 // The data format descriptor is not needed: vkFormat says everything for these four formats.
 // Returns typed arrays that WebGL2 uploads as they are (no conversion of the stored bits).
 

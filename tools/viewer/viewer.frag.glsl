@@ -1,6 +1,6 @@
 // tools/viewer/viewer.frag.glsl — the viewer's fragment shader, appended to the library's GLSL
 // (include/ibl/glsl/ibl_common, ibl_lookup, ibl_sh, ibl_shade) by viewer.js.
-//   u_mode 0  ibl-bake's preview.png, mirrored exactly (tools/ibl-bake/stage_preview.cpp): a 5 x 2
+//   u_mode 0  ibl-bake's preview.png, mirrored exactly (tools/ibl-bake/stages/stage_preview.cpp): a 5 x 2
 //             grid of 128-pixel cells, orthographic spheres of radius 0.45 cell, roughness 0.25 i
 //             (column i), dielectric base 0.8 on top, metal (0.95, 0.64, 0.54) below,
 //             multiple-scattering ambient (the bake's runtime model: the lobe LUT, the two-tap
@@ -125,7 +125,7 @@ vec3 view_at(float fx, float fy) {
     return shade_sphere(hit_n, -d, sphere_material(hit, u_roughness));
 }
 
-// tools/ibl-bake/image_io.cpp tonemap_png: x = L exposure, Reinhard x / (1 + x), sRGB OETF (the
+// tools/ibl-bake/io/image_io.cpp tonemap_png: x = L exposure, Reinhard x / (1 + x), sRGB OETF (the
 // framebuffer's 8-bit conversion rounds to nearest, as the PNG writer's floor(y 255 + 0.5)).
 float srgb_oetf(float x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055; }
 vec3 tonemap(vec3 l) {

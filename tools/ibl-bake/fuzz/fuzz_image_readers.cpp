@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <span>
 
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     const std::span<const unsigned char> bytes(data, size);

@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "bake_options.hpp"
+#include "options/bake_options.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     std::vector<std::string> args(1);

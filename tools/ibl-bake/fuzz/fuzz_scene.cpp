@@ -15,7 +15,7 @@
 
 #include <ibl/bake/plan.hpp>
 
-#include "scene_reader.hpp"
+#include "io/scene_reader.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
     ibl::plan_settings set;

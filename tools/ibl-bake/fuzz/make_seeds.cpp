@@ -18,8 +18,8 @@
 #include <ImfTiledRgbaFile.h>
 #include <half.h>
 
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 namespace {
 

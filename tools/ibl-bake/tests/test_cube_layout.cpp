@@ -5,9 +5,9 @@
 
 #include <doctest/doctest.h>
 
-#include "cube_layout.hpp"
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/cube_layout.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -14,9 +14,9 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 #include "tool_test_support.hpp"
-#include "json_value.hpp"
+#include "io/json_value.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -4,7 +4,7 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 
 #include <doctest/doctest.h>
 
-#include "json.hpp"
+#include "io/json.hpp"
 
 #include <cstdlib>
 #include <limits>

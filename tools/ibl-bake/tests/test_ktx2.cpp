@@ -4,8 +4,8 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 #include <bit>
 #include <cmath>

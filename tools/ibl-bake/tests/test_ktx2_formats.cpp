@@ -7,8 +7,8 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -12,11 +12,11 @@
 
 #include <doctest/doctest.h>
 
-#include "cube_layout.hpp"
-#include "image_io.hpp"
+#include "io/cube_layout.hpp"
+#include "io/image_io.hpp"
 #include "tool_test_support.hpp"
-#include "json_value.hpp"
-#include "ktx2.hpp"
+#include "io/json_value.hpp"
+#include "io/ktx2.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,10 +8,10 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 #include "tool_test_support.hpp"
-#include "json_value.hpp"
-#include "ktx2.hpp"
+#include "io/json_value.hpp"
+#include "io/ktx2.hpp"
 
 #include <cmath>
 #include <cstdlib>

@@ -5,8 +5,8 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
-#include "ktx2.hpp"
+#include "io/image_io.hpp"
+#include "io/ktx2.hpp"
 
 #include <cctype>
 #include <cmath>

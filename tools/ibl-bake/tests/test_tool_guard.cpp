@@ -6,7 +6,7 @@
 
 #include <doctest/doctest.h>
 
-#include "image_io.hpp"
+#include "io/image_io.hpp"
 
 #include <chrono>
 #include <cmath>

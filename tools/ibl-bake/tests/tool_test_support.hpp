@@ -10,8 +10,8 @@
 #include <string>
 #include <vector>
 
-#include "image_io.hpp"
-#include "json_value.hpp"
+#include "io/image_io.hpp"
+#include "io/json_value.hpp"
 
 #include <sys/wait.h>
 #include <unistd.h>
