@@ -16,12 +16,13 @@ CXX=${CXX_FUZZ:-clang++}
 mkdir -p "$OUT/corpus" "$OUT/artifacts" "$OUT/seeds"
 COMMON=(-std=c++20 -g -O1 -fno-omit-frame-pointer -I"$SRC" -isystem /usr/include/stb -isystem /usr/include/OpenEXR -isystem /usr/include/Imath)
 LIBS=(-lOpenEXR -lIex -lImath)
+IO=("$SRC/io/image_common.cpp" "$SRC/io/image_hdr.cpp" "$SRC/io/image_exr.cpp" "$SRC/io/image_png.cpp" "$SRC/io/ktx2.cpp")
 SAN=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
 
 echo "== building (clang: $($CXX --version | head -1))"
 "$CXX" "${COMMON[@]}" "${SAN[@]}" -fsanitize=fuzzer \
-    "$SRC/fuzz/fuzz_image_readers.cpp" "$SRC/io/image_io.cpp" "$SRC/io/ktx2.cpp" "${LIBS[@]}" -o "$OUT/fuzz_image_readers"
-"$CXX" "${COMMON[@]}" "$SRC/fuzz/make_seeds.cpp" "$SRC/io/image_io.cpp" "$SRC/io/ktx2.cpp" "${LIBS[@]}" -o "$OUT/make_seeds"
+    "$SRC/fuzz/fuzz_image_readers.cpp" "${IO[@]}" "${LIBS[@]}" -o "$OUT/fuzz_image_readers"
+"$CXX" "${COMMON[@]}" "$SRC/fuzz/make_seeds.cpp" "${IO[@]}" "${LIBS[@]}" -o "$OUT/make_seeds"
 
 echo "== seed corpus"
 "$OUT/make_seeds" "$OUT/seeds"

@@ -125,7 +125,7 @@ vec3 view_at(float fx, float fy) {
     return shade_sphere(hit_n, -d, sphere_material(hit, u_roughness));
 }
 
-// tools/ibl-bake/io/image_io.cpp tonemap_png: x = L exposure, Reinhard x / (1 + x), sRGB OETF (the
+// tools/ibl-bake/io/image_png.cpp tonemap_png: x = L exposure, Reinhard x / (1 + x), sRGB OETF (the
 // framebuffer's 8-bit conversion rounds to nearest, as the PNG writer's floor(y 255 + 0.5)).
 float srgb_oetf(float x) { return x <= 0.0031308 ? 12.92 * x : 1.055 * pow(x, 1.0 / 2.4) - 0.055; }
 vec3 tonemap(vec3 l) {

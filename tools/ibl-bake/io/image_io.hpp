@@ -32,7 +32,7 @@
 //   * threads: OpenEXR decodes in the calling thread (numThreads = 0 for every OpenEXR object;
 //     the global thread count, Imf::setGlobalThreadCount, is left alone).
 // Before OpenEXR parses anything, the headers of all parts are walked with bounds checks
-// (image_io.cpp, scan_exr_headers): attribute sizes that OpenEXR would misread, a `type`
+// (image_exr.cpp, scan_exr_headers): attribute sizes that OpenEXR would misread, a `type`
 // attribute that contradicts the file's layout (e.g. "deepscanline" in a scanline file), chunk
 // offset tables larger than the file, and sizes beyond the limits below are refused there.
 //

@@ -42,7 +42,7 @@ const std::string data_dir = IBL_BAKE_TEST_DATA_DIR;
 const std::string shared_dir = IBL_BAKE_SHARED_DATA_DIR;
 const std::string regression_dir = IBL_BAKE_REGRESSION_DIR;
 
-// ---- OpenEXR streams over memory (the test's own, independent of image_io.cpp) -----------------
+// ---- OpenEXR streams over memory (the test's own, independent of image_exr.cpp) -----------------
 
 class mem_out final : public Imf::OStream {
 public:
