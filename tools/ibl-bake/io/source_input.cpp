@@ -18,6 +18,18 @@ namespace {
 using dvec3 = ibl::vec3<double>;
 using fvec3 = ibl::vec3<float>;
 
+/// The layout of an image input (a face set or a KTX2 file is read before: automatic).
+layout_choice image_layout(input_form f) {
+    switch (f) {
+    case input_form::latlong: return layout_choice::latlong;
+    case input_form::hcross: return layout_choice::cross_horizontal;
+    case input_form::vcross: return layout_choice::cross_vertical;
+    case input_form::hstrip: return layout_choice::strip_horizontal;
+    case input_form::vstrip: return layout_choice::strip_vertical;
+    default: return layout_choice::automatic;
+    }
+}
+
 bool ends_with(const std::string& s, const std::string& suffix) {
     if (s.size() < suffix.size()) return false;
     std::string tail = s.substr(s.size() - suffix.size());
@@ -45,8 +57,9 @@ read_options input_read_options(const bake_options& opt) {
 void read_source(const bake_options& opt, source_env& src) {
     src.name = opt.input;
     const read_options ro = input_read_options(opt);
-    const bool faces = opt.input_layout == "faces" || (opt.input_layout == "auto" && opt.input.find("{face}") != std::string::npos);
-    const bool ktx2 = opt.input_layout == "ktx2" || (opt.input_layout == "auto" && ends_with(opt.input, ".ktx2"));
+    const bool automatic = opt.input_layout == input_form::automatic;
+    const bool faces = opt.input_layout == input_form::faces || (automatic && opt.input.find("{face}") != std::string::npos);
+    const bool ktx2 = opt.input_layout == input_form::ktx2 || (automatic && ends_with(opt.input, ".ktx2"));
     const std::uint64_t max_bytes = input_byte_limit(opt.max_input_pixels);
     if (faces) {
         for (const std::string& p : face_paths(opt.input)) check_input_file(p, max_bytes);
@@ -68,8 +81,7 @@ void read_source(const bake_options& opt, source_env& src) {
     }
     image_rgb32f img = read_image(opt.input, ro, &src.rr);
     src.values_clamped += clamp_radiance(img, src.rr); // the cube path below finds nothing left to clamp
-    const std::optional<layout_choice> choice = parse_layout_choice(opt.input_layout);
-    const input_layout layout = resolve_layout(img.width, img.height, choice ? *choice : layout_choice::automatic, opt.input);
+    const input_layout layout = resolve_layout(img.width, img.height, image_layout(opt.input_layout), opt.input);
     src.analytic = false;
     if (layout != input_layout::latlong) {
         set_cube(src, faces_from_layout(img, layout, opt.input), layout_name(layout));

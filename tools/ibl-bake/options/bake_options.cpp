@@ -26,8 +26,8 @@ quality_settings settings_for(quality q) {
     }
 }
 
-quality_settings check_settings_for(quality_settings q, const std::string& checks) {
-    if (checks != "fast") return q;
+quality_settings check_settings_for(quality_settings q, check_mode checks) {
+    if (checks != check_mode::fast) return q;
     q.ref_grid = std::max(3, q.ref_grid - 3);
     q.ld_ref_samples = std::max(256u, q.ld_ref_samples / 4);
     q.sky_ref_samples = std::max(256u, q.sky_ref_samples / 4);
@@ -36,6 +36,80 @@ quality_settings check_settings_for(quality_settings q, const std::string& check
 }
 
 int auto_levels(int size) { return ibl::prefilter_auto_levels(size); }
+
+const char* to_string(quality q) noexcept { return settings_for(q).name; }
+
+const char* to_string(bake_preset p) noexcept {
+    switch (p) {
+    case bake_preset::accurate: return "accurate";
+    case bake_preset::filament: return "filament";
+    case bake_preset::gltf: return "gltf";
+    case bake_preset::standard: break;
+    }
+    return "default";
+}
+
+const char* to_string(check_mode c) noexcept {
+    return c == check_mode::full ? "full" : c == check_mode::none ? "none" : "fast";
+}
+
+const char* to_string(sun_extraction s) noexcept {
+    return s == sun_extraction::automatic ? "auto" : s == sun_extraction::on ? "on" : "off";
+}
+
+const char* to_string(dfg_channel_order c) noexcept { return c == dfg_channel_order::filament ? "filament" : "ab"; }
+
+const char* to_string(runtime_choice r) noexcept {
+    return r == runtime_choice::lobe ? "lobe" : r == runtime_choice::taps2 ? "taps2" : "split-sum";
+}
+
+const char* to_string(level_layout l) noexcept {
+    switch (l) {
+    case level_layout::latlong: return "latlong";
+    case level_layout::cross: return "cross";
+    case level_layout::octahedral: return "octahedral";
+    case level_layout::faces: break;
+    }
+    return "faces";
+}
+
+const char* to_string(input_form f) noexcept {
+    switch (f) {
+    case input_form::latlong: return "latlong";
+    case input_form::hcross: return "hcross";
+    case input_form::vcross: return "vcross";
+    case input_form::hstrip: return "hstrip";
+    case input_form::vstrip: return "vstrip";
+    case input_form::faces: return "faces";
+    case input_form::ktx2: return "ktx2";
+    case input_form::automatic: break;
+    }
+    return "auto";
+}
+
+const char* to_string(ktx2_storage f) noexcept {
+    switch (f) {
+    case ktx2_storage::rgba32f: return "rgba32f";
+    case ktx2_storage::b10g11r11: return "b10g11r11";
+    case ktx2_storage::e5b9g9r9: return "e5b9g9r9";
+    case ktx2_storage::rgba16f: break;
+    }
+    return "rgba16f";
+}
+
+std::string to_string(const sh_window_choice& w) {
+    return w.k == sh_window_choice::kind::hanning ? w.text : w.k == sh_window_choice::kind::none ? "none" : "auto";
+}
+
+const char* to_string(ibl::ld_weight w) noexcept { return w == ibl::ld_weight::g1 ? "g1" : "nl"; }
+
+const char* to_string(ibl::roughness_mip_policy p) noexcept {
+    return p.mapping == ibl::roughness_mapping::filament ? "filament" : "linear";
+}
+
+ibl::ld_weight ld_weight_from(const std::string& name) noexcept {
+    return name == to_string(ibl::ld_weight::g1) ? ibl::ld_weight::g1 : ibl::ld_weight::n_dot_l;
+}
 
 namespace {
 
@@ -56,24 +130,31 @@ long long parse_integer(const std::string& option, const std::string& text, long
 
 namespace {
 
-/// One value from a fixed list, or a usage_error naming the choices.
-std::string choice(const std::string& option, const std::string& v, std::initializer_list<const char*> allowed) {
+std::string name_of(const std::string& name) { return name; }
+std::string name_of(const char* name) { return name; }
+template <class E> std::string name_of(const E& value) { return name_of(to_string(value)); }
+std::string name_of(const ibl::dfg_lut_layout& layout) { return layout.name(); }
+std::string name_of(const ibl::specular_lookup_desc& lookup) { return lookup.name(); }
+
+/// The value among `allowed` whose name is v, or a usage_error naming the choices.
+template <class E> E choice(const std::string& option, const std::string& v, std::initializer_list<E> allowed) {
     std::string list;
-    for (const char* a : allowed) {
-        if (v == a) return v;
-        list += (list.empty() ? "" : ", ") + std::string(a);
+    for (const E& a : allowed) {
+        if (v == name_of(a)) return a;
+        list += (list.empty() ? "" : ", ") + name_of(a);
     }
     throw usage_error(option + ": expected one of " + list + ", got '" + v + "'");
 }
 
 /// A comma-separated list of values from a fixed list (each once).
-std::vector<std::string> choices(const std::string& option, const std::string& v, std::initializer_list<const char*> allowed) {
-    std::vector<std::string> out;
+template <class E> std::vector<E> choices(const std::string& option, const std::string& v, std::initializer_list<E> allowed) {
+    std::vector<E> out;
     std::size_t b = 0;
     while (b <= v.size()) {
         const std::size_t e = std::min(v.find(',', b), v.size());
-        const std::string item = choice(option, v.substr(b, e - b), allowed);
-        if (std::find(out.begin(), out.end(), item) != out.end()) throw usage_error(option + ": '" + item + "' given twice");
+        const E item = choice(option, v.substr(b, e - b), allowed);
+        if (std::find(out.begin(), out.end(), item) != out.end())
+            throw usage_error(option + ": '" + name_of(item) + "' given twice");
         out.push_back(item);
         b = e + 1;
     }
@@ -90,19 +171,36 @@ std::string path_value(const std::string& option, const std::string& v) {
 /// n.l chain read by textureLod at lod(r), uniform (n.v, r) DFG table, nothing taken out of the
 /// environment); accurate = the more accurate conventions (G1 chain, remapped DFG table, the
 /// fitted lobe LUT, a compact sun taken out as a disk light, the log-geometric chain lookup).
-void apply_preset(bake_options& o, const std::string& p) {
+void apply_preset(bake_options& o, bake_preset p) {
     o.preset = p;
-    const bool accurate = p == "accurate";
-    const bool engine = p == "filament" || p == "gltf";
-    o.policy = p == "filament" ? "filament" : "linear";
-    o.specular_lookup = accurate ? "accurate" : "textbook";
-    o.dfg_layout = accurate ? "remapped" : "uniform";
-    o.dfg_channels = p == "filament" ? "filament" : "ab";
-    o.mirror = p == "filament";
-    o.extract_sun = accurate ? "auto" : "off";
+    const bool accurate = p == bake_preset::accurate;
+    const bool filament = p == bake_preset::filament;
+    const bool engine = filament || p == bake_preset::gltf;
+    o.policy = filament ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
+    o.specular_lookup = accurate ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
+    o.dfg_layout = accurate ? ibl::dfg_lut_layout::remapped() : ibl::dfg_lut_layout::uniform();
+    o.dfg_channels = filament ? dfg_channel_order::filament : dfg_channel_order::ab;
+    o.mirror = filament;
+    o.extract_sun = accurate ? sun_extraction::automatic : sun_extraction::off;
     o.irradiance_size = engine ? 0 : 32;
-    o.ld_weight = accurate ? "g1" : "nl";
-    o.runtime = accurate ? "lobe" : "split-sum";
+    o.ld_weight = accurate ? ibl::ld_weight::g1 : ibl::ld_weight::n_dot_l;
+    o.runtime = accurate ? runtime_choice::lobe : runtime_choice::split_sum;
+}
+
+/// --sh-window: auto, none or a Hanning width > 0.
+sh_window_choice sh_window_from(const std::string& option, const std::string& v) {
+    sh_window_choice w;
+    if (v == "auto") return w;
+    if (v == "none") {
+        w.k = sh_window_choice::kind::none;
+        return w;
+    }
+    const auto r = std::from_chars(v.data(), v.data() + v.size(), w.width);
+    if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !(w.width > 0.0) || !std::isfinite(w.width))
+        throw usage_error(option + ": expected auto, none or a width > 0, got '" + v + "'");
+    w.k = sh_window_choice::kind::hanning;
+    w.text = v;
+    return w;
 }
 
 using handler = std::function<void(bake_options&, const std::string&)>;
@@ -117,51 +215,44 @@ const std::map<std::string, option_spec>& option_table() {
         {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
         {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
         {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
-        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {"default", "accurate", "filament", "gltf"})); }}},
-        {"--policy", {true, [](bake_options& o, const std::string& v) { o.policy = choice("--policy", v, {"linear", "filament"}); }}},
+        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {bake_preset::standard, bake_preset::accurate, bake_preset::filament, bake_preset::gltf})); }}},
+        {"--policy", {true, [](bake_options& o, const std::string& v) { o.policy = choice("--policy", v, {ibl::roughness_mip_policy::linear(), ibl::roughness_mip_policy::filament()}); }}},
         {"--mirror", {false, [](bake_options& o, const std::string&) { o.mirror = true; }}},
         {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
         {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
         {"--strict", {false, [](bake_options& o, const std::string&) { o.strict = true; }}},
-        {"--checks", {true, [](bake_options& o, const std::string& v) { o.checks = choice("--checks", v, {"fast", "full", "none"}); }}},
+        {"--checks", {true, [](bake_options& o, const std::string& v) { o.checks = choice("--checks", v, {check_mode::fast, check_mode::full, check_mode::none}); }}},
         {"--verbose", {false, [](bake_options& o, const std::string&) { o.verbose = true; }}},
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
         {"--sh-bands", {true, [](bake_options& o, const std::string& v) { o.sh_bands = int(parse_integer("--sh-bands", v, 2, 5)); }}},
-        {"--sh-window", {true, [](bake_options& o, const std::string& v) {
-             if (v != "auto" && v != "none") {
-                 double w = 0.0;
-                 const auto r = std::from_chars(v.data(), v.data() + v.size(), w);
-                 if (v.empty() || r.ec != std::errc() || r.ptr != v.data() + v.size() || !(w > 0.0) || !std::isfinite(w))
-                     throw usage_error("--sh-window: expected auto, none or a width > 0, got '" + v + "'");
-             }
-             o.sh_window = v;
-         }}},
+        {"--sh-window", {true, [](bake_options& o, const std::string& v) { o.sh_window = sh_window_from("--sh-window", v); }}},
         {"--irradiance-size", {true, [](bake_options& o, const std::string& v) {
              o.irradiance_size = int(parse_integer("--irradiance-size", v, 0, 256));
          }}},
         {"--extract-sun", {true, [](bake_options& o, const std::string& v) {
-             o.extract_sun = choice("--extract-sun", v, {"auto", "on", "off"});
+             o.extract_sun = choice("--extract-sun", v, {sun_extraction::automatic, sun_extraction::on, sun_extraction::off});
          }}},
         {"--dfg-layout", {true, [](bake_options& o, const std::string& v) {
-             o.dfg_layout = choice("--dfg-layout", v, {"remapped", "uniform"});
+             o.dfg_layout = choice("--dfg-layout", v, {ibl::dfg_lut_layout::remapped(), ibl::dfg_lut_layout::uniform()});
          }}},
         {"--specular-lookup", {true, [](bake_options& o, const std::string& v) {
-             o.specular_lookup = choice("--specular-lookup", v, {"textbook", "accurate"});
+             o.specular_lookup = choice("--specular-lookup", v, {ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc::accurate()});
          }}},
-        {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {"g1", "nl"}); }}},
-        {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {"lobe", "taps2", "split-sum"}); }}},
+        {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {ibl::ld_weight::g1, ibl::ld_weight::n_dot_l}); }}},
+        {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {runtime_choice::lobe, runtime_choice::taps2, runtime_choice::split_sum}); }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
              o.part = v;
          }}},
         {"--input-layout", {true, [](bake_options& o, const std::string& v) {
-             o.input_layout = choice("--input-layout", v, {"auto", "latlong", "hcross", "vcross", "hstrip", "vstrip", "faces", "ktx2"});
+             o.input_layout = choice("--input-layout", v, {input_form::automatic, input_form::latlong, input_form::hcross, input_form::vcross,
+                                                            input_form::hstrip, input_form::vstrip, input_form::faces, input_form::ktx2});
          }}},
         {"--layout", {true, [](bake_options& o, const std::string& v) {
-             o.layouts = choices("--layout", v, {"faces", "latlong", "cross", "octahedral"});
+             o.layouts = choices("--layout", v, {level_layout::faces, level_layout::latlong, level_layout::cross, level_layout::octahedral});
          }}},
         {"--size", {true, [](bake_options& o, const std::string& v) { o.size = int(parse_integer("--size", v, 1, 4096)); }}},
         {"--lut-size", {true, [](bake_options& o, const std::string& v) { o.lut_size = int(parse_integer("--lut-size", v, 1, 1024)); }}},
@@ -171,13 +262,12 @@ const std::map<std::string, option_spec>& option_table() {
              o.max_input_pixels = std::uint64_t(parse_integer("--max-input-pixels", v, 1, 1ll << 32));
          }}},
         {"--quality", {true, [](bake_options& o, const std::string& v) {
-             const std::string q = choice("--quality", v, {"low", "default", "high"});
-             o.q = q == "low" ? quality::low : q == "high" ? quality::high : quality::standard;
+             o.q = choice("--quality", v, {quality::low, quality::standard, quality::high});
          }}},
         {"--ktx2-format", {true, [](bake_options& o, const std::string& v) {
-             const std::string f = choice("--ktx2-format", v, {"f16", "f32", "rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"});
-             o.ktx2_format = f == "f16" ? "rgba16f" : f == "f32" ? "rgba32f" : f;
-             o.ktx2_f32 = o.ktx2_format == "rgba32f";
+             const std::string f = choice("--ktx2-format", v, std::initializer_list<std::string>{"f16", "f32", "rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"});
+             o.ktx2_format = choice("--ktx2-format", f == "f16" ? "rgba16f" : f == "f32" ? "rgba32f" : f,
+                                    {ktx2_storage::rgba16f, ktx2_storage::rgba32f, ktx2_storage::b10g11r11, ktx2_storage::e5b9g9r9});
          }}},
     };
     return t;

@@ -52,6 +52,10 @@
 #include <vector>
 
 #include <ibl/bake/dfg.hpp>
+#include <ibl/runtime/dfg_layout.hpp>
+#include <ibl/runtime/ld_weight.hpp>
+#include <ibl/runtime/lookup.hpp>
+#include <ibl/runtime/roughness_mip.hpp>
 
 namespace ibl_bake {
 
@@ -62,6 +66,54 @@ public:
 
 enum class quality { low, standard, high };
 
+// The option values, parsed once by parse_options: what a stage tests is one of these, never the
+// text of the command line. Where the library has the type (ibl::ld_weight, ibl::dfg_lut_layout,
+// ibl::roughness_mip_policy, ibl::specular_lookup_desc) the option holds it. to_string gives the
+// one name each value has on the command line, in report.json and in the files' metadata.
+
+/// --preset: a set of conventions (docs/ibl-bake.md, "Presets"); `standard` is named "default".
+enum class bake_preset { standard, accurate, filament, gltf };
+/// --checks: the reference checks (check_settings_for).
+enum class check_mode { fast, full, none };
+/// --extract-sun: a compact dominant source taken out as a disk light (automatic: when it is compact).
+enum class sun_extraction { off, automatic, on };
+/// The DFG table's channels: (A, B, k), or Filament's (B, A + B, k) for mix(x, y, f0).
+enum class dfg_channel_order { ab, filament };
+/// --runtime: the runtime model the products are for.
+enum class runtime_choice { split_sum, lobe, taps2 };
+/// --layout: the files of each specular level.
+enum class level_layout { faces, latlong, cross, octahedral };
+/// --input-layout: how --input is read (automatic: from its name and aspect ratio).
+enum class input_form { automatic, latlong, hcross, vcross, hstrip, vstrip, faces, ktx2 };
+/// --ktx2-format: the storage of the KTX2 files (ktx2.hpp's ktx2_format of the same names).
+enum class ktx2_storage { rgba16f, rgba32f, b10g11r11, e5b9g9r9 };
+
+/// --sh-window: automatic (a Hanning window when the SH go negative), none, or a Hanning width.
+struct sh_window_choice {
+    enum class kind { automatic, none, hanning };
+    kind k = kind::automatic;
+    double width = 0.0; ///< kind::hanning: the width
+    std::string text;   ///< kind::hanning: the width as given (report.json repeats it)
+};
+
+const char* to_string(quality q) noexcept;
+const char* to_string(bake_preset p) noexcept;
+const char* to_string(check_mode c) noexcept;
+const char* to_string(sun_extraction s) noexcept;
+const char* to_string(dfg_channel_order c) noexcept;
+const char* to_string(runtime_choice r) noexcept;
+const char* to_string(level_layout l) noexcept;
+const char* to_string(input_form f) noexcept;
+const char* to_string(ktx2_storage f) noexcept;
+std::string to_string(const sh_window_choice& w);
+/// "g1" | "nl"
+const char* to_string(ibl::ld_weight w) noexcept;
+/// "linear" | "filament"
+const char* to_string(ibl::roughness_mip_policy p) noexcept;
+
+/// The LD weight of a name to_string gives (files read back by --lookup); nl for any other.
+ibl::ld_weight ld_weight_from(const std::string& name) noexcept;
+
 struct bake_options {
     std::string input;   ///< empty: the built-in sky
     std::string out;
@@ -70,33 +122,33 @@ struct bake_options {
     int levels = 0;      ///< 0: automatic
     unsigned threads = 0;
     quality q = quality::standard;
-    bool ktx2_f32 = false;       ///< ktx2_format == "rgba32f"
-    std::string ktx2_format = "rgba16f"; ///< rgba16f | rgba32f | b10g11r11 | e5b9g9r9
+    ktx2_storage ktx2_format = ktx2_storage::rgba16f;
     std::string part;            ///< --part: EXR part name (empty: the first with R, G, B)
-    std::string input_layout = "auto"; ///< auto | latlong | hcross | vcross | faces | ktx2
-    std::vector<std::string> layouts{"faces"}; ///< per-level files: faces, latlong, cross, octahedral
+    input_form input_layout = input_form::automatic;
+    std::vector<level_layout> layouts{level_layout::faces}; ///< per-level files
     std::uint64_t max_input_pixels = std::uint64_t(1) << 27; ///< 16384 x 8192
     bool quiet = false;
     bool help = false;
     bool version = false;
     int sh_bands = 0;                          ///< --sh-bands 2..5; 0: the plan's (3 in the full bake)
-    std::string sh_window = "auto";            ///< auto | none | a Hanning width W > 0
+    sh_window_choice sh_window;                ///< --sh-window (applies to irradiance / shader)
     int irradiance_size = 32;                  ///< --irradiance-size: face of the irradiance map (0: none)
-    std::string extract_sun = "off";           ///< auto (a compact dominant source as a disk light) | on | off
+    sun_extraction extract_sun = sun_extraction::off;
     bool sheen = false;                        ///< --sheen: the Charlie sheen chain and LUT
-    std::string preset = "default";            ///< default (textbook) | accurate | filament | gltf (sets the fields below)
-    std::string policy = "linear";             ///< roughness <-> lod: linear | filament (lod = r (2 - r) ...)
-    std::string dfg_channels = "ab";           ///< ab: (A, B, k) | filament: (B, A + B, k) for mix(x, y, f0)
+    bake_preset preset = bake_preset::standard; ///< --preset (sets the fields below)
+    ibl::roughness_mip_policy policy = ibl::roughness_mip_policy::linear(); ///< roughness <-> lod of the chain
+    dfg_channel_order dfg_channels = dfg_channel_order::ab;
     bool mirror = false;                       ///< the environment mirrored x -> -x (cmgen's default)
-    std::string dfg_layout = "uniform";        ///< uniform (ibl::dfg_lut_layout::uniform(), textbook) | remapped
-    std::string specular_lookup = "textbook";  ///< textbook (textureLod at lod(r)) | accurate (log-geometric)
-    std::string ld_weight = "nl";              ///< the chain's LD weight: nl (Karis) | g1 (ibl::ld_weight)
-    std::string runtime = "split-sum";         ///< the runtime model: split-sum | lobe (lobe LUT) | taps2 (two-tap table)
+    ibl::dfg_lut_layout dfg_layout = ibl::dfg_lut_layout::uniform(); ///< uniform (textbook) | remapped
+    /// textbook (textureLod at lod(r)) | accurate (log-geometric); its mapping is the plan's policy's
+    ibl::specular_lookup_desc specular_lookup = ibl::specular_lookup_desc::textbook();
+    ibl::ld_weight ld_weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight: nl (Karis) | g1
+    runtime_choice runtime = runtime_choice::split_sum;
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)
     bool strict = false;       ///< --strict (with --scene): a missed error target fails the bake
-    std::string checks = "fast"; ///< the reference checks: fast | full | none (check_settings_for)
+    check_mode checks = check_mode::fast; ///< the reference checks (check_settings_for)
     bool verbose = false;      ///< --verbose: the wide report table
 };
 
@@ -120,7 +172,7 @@ quality_settings settings_for(quality q);
 /// The quality's settings with the check knobs of a --checks mode: full keeps them; fast takes a
 /// coarser texel grid (ref_grid - 3, at least 3), a quarter of the reference samples and an
 /// eighth of the split-sum reference's (docs/ibl-bake.md "Checks"); none keeps them (no check runs).
-quality_settings check_settings_for(quality_settings q, const std::string& checks);
+quality_settings check_settings_for(quality_settings q, check_mode checks);
 
 /// Parses argv[1..argc). Throws usage_error.
 bake_options parse_options(const std::vector<std::string>& args);

@@ -225,7 +225,7 @@ void check_layout_attribute(const std::string& path, const ibl::dfg_lut_layout& 
 
 /// The runtime model of plan.runtime (bakes before it: the split sum of an n.l chain).
 void load_runtime_model(baked_folder& b, const json_value& rt, const std::string& dir) {
-    if (const json_value* w = rt.find("ld_weight"); w && w->find("name")) b.weight = ld_weight_named(w->find("name")->string);
+    if (const json_value* w = rt.find("ld_weight"); w && w->find("name")) b.weight = ld_weight_from(w->find("name")->string);
     const json_value* m = rt.find("runtime_model");
     if (m && m->find("name") && m->find("name")->string == "taps2") {
         load_taps(b, dir);
@@ -264,8 +264,10 @@ baked_folder load_baked_folder(const std::string& dir) {
         b.chain = cube_from_ktx2(dir + "/specular.ktx2");
         b.has_chain = true;
     }
-    b.specular = specular_lookup_named(member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? "textbook" : "accurate");
-    b.dfg_layout = dfg_layout_named(member(member(rt, "dfg_layout", rp), "edge_aligned", rp).boolean ? "remapped" : "uniform");
+    b.specular = member(member(rt, "specular_lookup", rp), "name", rp).string == "textbook" ? ibl::specular_lookup_desc::textbook()
+                                                                                           : ibl::specular_lookup_desc::accurate();
+    b.dfg_layout = member(member(rt, "dfg_layout", rp), "edge_aligned", rp).boolean ? ibl::dfg_lut_layout::remapped()
+                                                                                     : ibl::dfg_lut_layout::uniform();
     b.specular.mapping = b.filament_policy ? ibl::roughness_mapping::filament : ibl::roughness_mapping::linear;
     if (member(rt, "dfg_size", rp).number > 0) {
         b.lut = lut_from_exr(dir + "/dfg.exr", int(member(rt, "dfg_channels", rp).number));

@@ -59,7 +59,7 @@ bool reference_check(const stage& s) {
 std::vector<std::unique_ptr<stage>> run_stages(bake_context& ctx) {
     std::vector<std::unique_ptr<stage>> ran;
     for (auto& s : all_stages()) {
-        if (!s->enabled(ctx) || (ctx.opt.checks == "none" && reference_check(*s))) continue;
+        if (!s->enabled(ctx) || (ctx.opt.checks == check_mode::none && reference_check(*s))) continue;
         s->run(ctx);
         if (s->kind() == stage_kind::product) add_time(ctx.measured, *s);
         ran.push_back(std::move(s));
@@ -78,8 +78,8 @@ void report_options(json_writer& j, const bake_context& ctx) {
     j.key("levels").value(ctx.set.levels);
     j.key("quality").value(ctx.qs.name);
     j.key("threads").value(ctx.ex.threads());
-    j.key("ktx2_format").value(o.ktx2_f32 ? "rgba32f" : "rgba16f");
-    j.key("checks").value(o.checks);
+    j.key("ktx2_format").value(o.ktx2_format == ktx2_storage::rgba32f ? "rgba32f" : "rgba16f");
+    j.key("checks").value(to_string(o.checks));
     j.end_object();
     // the sizes baked (a scene's plan may use less than --size and --lut-size); level 0 = the mirror level
     const ibl::specular_plan& sp = ctx.plan.specular;
@@ -110,9 +110,9 @@ std::vector<table_row> all_rows(const std::vector<std::unique_ptr<stage>>& stage
     return rows;
 }
 
-const char* checks_accuracy(const std::string& mode) {
-    if (mode == "none") return "no reference checks ran (--checks none): the products are written unchecked";
-    if (mode == "full") return "the full references of the quality (docs/ibl-bake.md, quality table)";
+const char* checks_accuracy(check_mode mode) {
+    if (mode == check_mode::none) return "no reference checks ran (--checks none): the products are written unchecked";
+    if (mode == check_mode::full) return "the full references of the quality (docs/ibl-bake.md, quality table)";
     return "fast: a texel grid 3 smaller per side (at least 3), a quarter of the reference LD samples, an eighth of the "
            "split-sum reference samples (reference_rel_std_error gives that noise), the lookup check at the roughness midway "
            "between levels with the chosen lookup only and texel-sum references of 4 texels per alpha, the irradiance brute "
@@ -127,7 +127,7 @@ const char* checks_accuracy(const std::string& mode) {
 void report_checks(json_writer& j, const bake_context& ctx, const std::vector<std::unique_ptr<stage>>& stages, double total_ms) {
     const double t = checks_ms(stages);
     j.key("checks").begin_object();
-    j.key("mode").value(ctx.opt.checks);
+    j.key("mode").value(to_string(ctx.opt.checks));
     j.key("time_ms").value(t);
     j.key("share_of_run").value(total_ms > 0.0 ? t / total_ms : 0.0);
     j.key("stages_ms").begin_object();
@@ -220,7 +220,7 @@ void print_report(std::FILE* out, const bake_context& ctx, const std::vector<std
     char setup[240];
     std::snprintf(setup, sizeof setup, "%s: size %d, %s, LUT %d, quality %s, checks %s, %u threads",
                   ctx.scene_mode ? "scene plan" : "full bake", std::max(1, sp.virtual_base_size >> sp.first_level), levels.c_str(),
-                  ctx.plan.dfg.size, ctx.qs.name, ctx.opt.checks.c_str(), ctx.ex.threads());
+                  ctx.plan.dfg.size, ctx.qs.name, to_string(ctx.opt.checks), ctx.ex.threads());
     if (verbose) std::fprintf(out, "%s (%s)\n\n", head.c_str(), setup);
     else if (head.size() < compact_width) std::fprintf(out, "%s\n%s\n\n", head.c_str(), setup);
     else std::fprintf(out, "ibl-bake %s: %s\n  -> %s\n%s\n\n", version_string().c_str(), ctx.src.name.c_str(), ctx.opt.out.c_str(), setup);
@@ -240,11 +240,11 @@ void print_report(std::FILE* out, const bake_context& ctx, const std::vector<std
                                fmt("diffuse %.1f, ", t.diffuse) + fmt("dfg %.1f, ", t.dfg) + fmt("lobe lut %.1f", t.lobe),
                       2);
     const double c = checks_ms(stages);
-    if (ctx.opt.checks == "none")
+    if (ctx.opt.checks == check_mode::none)
         print_wrapped(out, "checks skipped (--checks none): no product was measured against a reference", 2);
     else
         print_wrapped(out, fmt("checks %.1f ms", c) + fmt(" = %.0f%% of the run (", 100.0 * c / std::max(total_ms, 1e-9)) +
-                               ctx.opt.checks + (ctx.opt.checks == "fast" ? "; --checks full: the full references)" : ")"),
+                               to_string(ctx.opt.checks) + (ctx.opt.checks == check_mode::fast ? "; --checks full: the full references)" : ")"),
                       2);
     for (const auto& s : stages)
         for (const auto& line : s->notes_after()) std::fprintf(out, "%s\n", line.c_str());

@@ -144,23 +144,13 @@ ibl::ibl_sample<double> product_view::sample(const dvec3& n, const dvec3& v, dou
     return s;
 }
 
-ibl::dfg_lut_layout dfg_layout_named(const std::string& name) {
-    return name == "uniform" ? ibl::dfg_lut_layout::uniform() : ibl::dfg_lut_layout::remapped();
-}
-
-ibl::specular_lookup_desc specular_lookup_named(const std::string& name) {
-    return name == "accurate" ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
-}
-
-ibl::ld_weight ld_weight_named(const std::string& name) { return name == "g1" ? ibl::ld_weight::g1 : ibl::ld_weight::n_dot_l; }
-
 int lobe_lut_size_for(int dfg_size) { return std::clamp(dfg_size, 1, 24); }
 
 runtime_model runtime_model_of(const bake_options& o, const ibl::bake_plan& plan) {
     runtime_model m;
     m.ld_weight = o.ld_weight;
-    if ((o.runtime == "lobe" || o.runtime == "taps2") && plan.dfg.enabled && plan.dfg.size > 0 && plan.specular.enabled) {
-        m.name = o.runtime;
+    if (o.runtime != runtime_choice::split_sum && plan.dfg.enabled && plan.dfg.size > 0 && plan.specular.enabled) {
+        m.kind = o.runtime;
         m.lobe_lut_size = lobe_lut_size_for(plan.dfg.size);
     }
     return m;
@@ -175,13 +165,13 @@ const char* axis_name(ibl::dfg_axis a) {
 namespace {
 void json_runtime_model(json_writer& j, const runtime_model& rm) {
     j.key("ld_weight").begin_object();
-    j.key("name").value(rm.ld_weight);
-    j.key("rule").value(rm.ld_weight == "g1" ? "LD = int L D(h) G1(R.l) dl / int D(h) G1(R.l) dl (the specular lobe at n.v = 1)"
+    j.key("name").value(to_string(rm.ld_weight));
+    j.key("rule").value(rm.ld_weight == ibl::ld_weight::g1 ? "LD = int L D(h) G1(R.l) dl / int D(h) G1(R.l) dl (the specular lobe at n.v = 1)"
                                              : "LD = int L D(h) (R.l) dl / int D(h) (R.l) dl (Karis 2013)");
     j.end_object();
     j.key("runtime_model").begin_object();
-    j.key("name").value(rm.name);
-    if (rm.name == "lobe") {
+    j.key("name").value(to_string(rm.kind));
+    if (rm.kind == runtime_choice::lobe) {
         j.key("lut").value("lobe_lut.exr (lobe_lut.hpp)").key("lut_size").value(rm.lobe_lut_size);
         j.key("channels").value("R = A, G = B, B = s, A = r_eff");
         j.key("lut_b").value("lobe_lut_b.exr (lobe_lut_b.hpp)");
@@ -192,7 +182,7 @@ void json_runtime_model(json_writer& j, const runtime_model& rm) {
                             "F0 A LD(normalize(lerp(n, R, s)), r_eff) + F90 B LD(cos(a_B) n + sin(a_B) t, r_B) "
                             "(ibl::specular_lobe_pair: the A part of the lobe by the whole lobe's kernel, the Fresnel B "
                             "part by its own)");
-    } else if (rm.name == "taps2") {
+    } else if (rm.kind == runtime_choice::taps2) {
         j.key("lut").value("lobe_taps_a.exr, lobe_taps_b.exr (lobe_taps.hpp)").key("lut_size").value(rm.lobe_lut_size);
         j.key("channels").value("lobe_taps_a: R = A, G = B, B = angle0 / acos(n.v), A = roughness0; lobe_taps_b: R = weight0, "
                                 "G = angle1 / acos(n.v), B = roughness1, A = weight1");
@@ -229,7 +219,7 @@ void json_lookup_conventions(json_writer& j, const ibl::specular_lookup_desc& s,
 
 std::vector<std::pair<std::string, std::string>> product_conventions(const bake_context& ctx, const std::string& product,
                                                                      const std::string& how_to_read) {
-    return {{"ibl.preset", ctx.opt.preset},
+    return {{"ibl.preset", to_string(ctx.opt.preset)},
             {"ibl.product", product},
             {"ibl.sun_extracted", ctx.sun ? "yes: a compact bright source was taken out into lights.json (a disk light the "
                                             "renderer must add); this file holds the rest of the environment"
@@ -251,9 +241,9 @@ std::vector<std::pair<std::string, std::string>> table_conventions(const bake_co
 
 product_view baked_view(const bake_context& ctx) {
     product_view v;
-    v.specular = specular_lookup_named(ctx.opt.specular_lookup);
+    v.specular = ctx.opt.specular_lookup;
     v.specular.mapping = ctx.plan.specular.policy.mapping;
-    v.dfg_layout = dfg_layout_named(ctx.opt.dfg_layout);
+    v.dfg_layout = ctx.opt.dfg_layout;
     v.chain = ctx.chain ? &*ctx.chain : nullptr;
     v.policy = ctx.plan.specular.policy;
     v.virtual_levels = ctx.plan.specular.virtual_levels;
@@ -264,7 +254,7 @@ product_view baked_view(const bake_context& ctx) {
     v.lobe = ctx.lobe ? &*ctx.lobe : nullptr;
     v.lobe_b = ctx.lobe_b ? &*ctx.lobe_b : nullptr;
     v.taps = ctx.taps ? &*ctx.taps : nullptr;
-    v.weight = ld_weight_named(ctx.opt.ld_weight);
+    v.weight = ctx.opt.ld_weight;
     return v;
 }
 
@@ -376,16 +366,19 @@ void write_text(const std::string& path, const std::string& text) {
     write_file_atomic(path, std::span<const unsigned char>(reinterpret_cast<const unsigned char*>(text.data()), text.size()));
 }
 
-ktx2_format ktx2_format_named(const std::string& name) {
-    if (name == "rgba32f") return ktx2_format::rgba32f;
-    if (name == "b10g11r11") return ktx2_format::b10g11r11;
-    if (name == "e5b9g9r9") return ktx2_format::e5b9g9r9;
+ktx2_format ktx2_format_of(ktx2_storage storage) {
+    switch (storage) {
+    case ktx2_storage::rgba32f: return ktx2_format::rgba32f;
+    case ktx2_storage::b10g11r11: return ktx2_format::b10g11r11;
+    case ktx2_storage::e5b9g9r9: return ktx2_format::e5b9g9r9;
+    case ktx2_storage::rgba16f: break;
+    }
     return ktx2_format::rgba16f;
 }
 
-void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format) {
+void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, ktx2_storage format) {
     j.begin_object();
-    j.key("format").value(format);
+    j.key("format").value(to_string(format));
     j.key("relative_to").value("max(|x|, floor), floor = 1e-3 x the level's mean |x|");
     j.key("levels").begin_array();
     for (const auto& l : q) {

@@ -128,7 +128,7 @@ void compare_full_stage::bake_full(bake_context& ctx) {
     fsource_ = bake_source(ctx.src, ctx.full.source_size, ctx.qs.bake_k, ctx.ex);
     tf_.source = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
-    fchain_ = bake_chain(fsource_, ctx.full.specular, ld_weight_named(ctx.opt.ld_weight), ctx.ex);
+    fchain_ = bake_chain(fsource_, ctx.full.specular, ctx.opt.ld_weight, ctx.ex);
     tf_.specular = ms_since(t0);
     t0 = std::chrono::steady_clock::now();
     fdiffuse_ = sh3_diffuse(fsource_, ctx.ex);
@@ -151,7 +151,7 @@ void compare_full_stage::bake_converged(bake_context& ctx) {
         l.size = std::max(1, ctx.opt.size >> l.level);
         if (l.level > 0) l.samples = 4096;
     }
-    conv_.chain = bake_chain(fsource_, cp, ld_weight_named(ctx.opt.ld_weight), ctx.ex);
+    conv_.chain = bake_chain(fsource_, cp, ctx.opt.ld_weight, ctx.ex);
     for (const auto& p : scene_shading_points()) conv_.normals.push_back(p.n);
     conv_.e_brute = texel_sum_irradiance(fsource_, level_at_most(fsource_, 64), conv_.normals, ctx.ex);
     conv_.view = {&conv_.chain, ctx.set.policy, ctx.set.levels, ctx.plan.specular.first_level, nullptr, nullptr};
@@ -173,7 +173,7 @@ void compare_full_stage::check_levels(bake_context& ctx) {
     ctx.prog.begin("specular levels vs reference");
     const dvec3 light = brightest_direction(fsource_, 0);
     const ibl::specular_plan& sp = ctx.plan.specular;
-    const ibl::ld_weight w = ld_weight_named(ctx.opt.ld_weight); // the chains' weight
+    const ibl::ld_weight w = ctx.opt.ld_weight; // the chains' weight
     for (std::size_t k = 0; k < sp.levels.size(); ++k) {
         const ibl::specular_level_plan& lp = sp.levels[k];
         if (lp.level == 0 || !lp.needed) continue;

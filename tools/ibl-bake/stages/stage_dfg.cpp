@@ -35,8 +35,8 @@ public:
         nodes_ = ctx.qs.dfg_nodes;
         quality_ = ctx.qs.name;
         ctx.prog.begin("dfg lut");
-        layout_ = dfg_layout_named(ctx.opt.dfg_layout);
-        filament_channels_ = ctx.opt.dfg_channels == "filament";
+        layout_ = ctx.opt.dfg_layout;
+        filament_channels_ = ctx.opt.dfg_channels == dfg_channel_order::filament;
         ctx.lut = ibl::make_dfg_lut_exact<bake_model>(std::uint32_t(ctx.plan.dfg.size), layout_,
                                                       std::uint32_t(ctx.plan.dfg.channels), nodes_, ctx.ex);
         ms_ = ctx.prog.end();
@@ -46,7 +46,7 @@ public:
                                                                   : "R = A, G = B, B = k (specular = LD (F0 A + F90 B))") +
                                        "; EXR row 0 (top) is the smallest roughness",
                                    layout_, {{"ibl.model", lut_->model}, {"ibl.dfg_channels", filament_channels_ ? "B, A + B, k" : "A, B, k"}});
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (!checked_) return;
         ctx.prog.begin("check dfg");
         check(ctx.ex);

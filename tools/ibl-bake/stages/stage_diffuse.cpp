@@ -41,7 +41,7 @@ constexpr int brute_max_face = 128; ///< brute-force irradiance over a source le
 double min3(const dvec3& v) { return std::min({v.x, v.y, v.z}); }
 
 /// The brute-force level's largest face: --checks fast sums over a level of face <= 64.
-int brute_face(const bake_context& ctx) { return ctx.opt.checks == "fast" ? 64 : brute_max_face; }
+int brute_face(const bake_context& ctx) { return ctx.opt.checks == check_mode::fast ? 64 : brute_max_face; }
 
 std::vector<dvec3> check_normals() {
     std::vector<dvec3> normals;
@@ -110,7 +110,7 @@ public:
     void run(bake_context& ctx) override {
         bands_ = ctx.opt.sh_bands > 0 ? ctx.opt.sh_bands : ctx.plan.diffuse.sh_bands == 2 ? 2 : 3;
         window_ = ctx.opt.sh_window;
-        filament_ = ctx.opt.preset == "filament";
+        filament_ = ctx.opt.preset == bake_preset::filament;
         texels_ = 6 * ctx.source.size(0) * ctx.source.size(0);
         ctx.prog.begin("sh");
         switch (bands_) {
@@ -130,7 +130,7 @@ public:
         }
         conventions_ = product_conventions(ctx, "sh", "real SH radiance coefficients; E(n) and E(n)/pi reconstructed as "
                                                       "'convention' says");
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (checked_) check(ctx);
     }
 
@@ -176,9 +176,10 @@ private:
             src.size(0), [&](int f, int x, int y) { return dvec3(src.texel(f, x, y, 0)); }, ctx.ex);
         ibl::sh_coeffs<double, B> rad = raw;
         min_before_ = min_after_ = ibl::sh_min_irradiance(raw, 4096).value;
-        bool apply = window_ != "none" && window_ != "auto";
-        if (window_ == "auto") apply = min3(min_before_) < 0.0;
-        if (apply && window_ == "auto") {
+        const bool automatic = window_.k == sh_window_choice::kind::automatic;
+        bool apply = window_.k == sh_window_choice::kind::hanning;
+        if (automatic) apply = min3(min_before_) < 0.0;
+        if (apply && automatic) {
             const ibl::sh_auto_window_result<double, B> win = ibl::sh_auto_window(raw);
             windowed_ = std::isfinite(win.width);
             width_ = win.width;
@@ -190,7 +191,7 @@ private:
                         for (int k = 0; k < B * B; ++k) rad[k][c] = 0.0;
                     }
         } else if (apply) {
-            width_ = std::stod(window_);
+            width_ = window_.width;
             windowed_ = true;
             rad = ibl::sh_apply_window(raw, ibl::sh_window_kind::hanning, width_);
         }
@@ -202,7 +203,7 @@ private:
 
     std::vector<std::pair<std::string, std::string>> conventions_;
     int bands_ = 3, texels_ = 0;
-    std::string window_ = "auto";
+    sh_window_choice window_;
     bool windowed_ = false, clamped_ = false, sun_ = false, filament_ = false, checked_ = true;
     double width_ = 0.0, ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;
     dvec3 min_before_{0.0}, min_after_{0.0};
@@ -247,7 +248,7 @@ std::string sh_stage::sh_json() const {
     j.key("kind").value("hanning");
     if (windowed_) j.key("width").value(width_);
     else j.key("width").null();
-    j.key("choice").value(window_);
+    j.key("choice").value(to_string(window_));
     j.key("rule").value("'radiance' is the raw projection. --sh-window auto: the weakest Hanning window keeping E >= 0 "
                         "(ibl::sh_auto_window) whenever the raw irradiance's minimum is negative in a channel (a channel no window "
                         "can make non-negative is clamped to 0); none; or a width W. A window scales band l of the irradiance and "
@@ -266,7 +267,7 @@ void sh_stage::report(json_writer& j) const {
     j.key("method").value(std::to_string(bands_) + "-band projection of the source cube (exact texel solid angles), Lambert convolution");
     j.key("cost").begin_object().key("bands").value(bands_).key("texels").value(texels_).end_object();
     j.key("time_ms").value(ms_);
-    j.key("window_choice").value(window_);
+    j.key("window_choice").value(to_string(window_));
     j.key("window_applied").value(windowed_);
     if (windowed_) j.key("window_width").value(width_);
     else j.key("window_width").null();
@@ -314,7 +315,7 @@ public:
         format_ = ctx.opt.ktx2_format;
         attrs_ = product_conventions(ctx, "irradiance", "texel holds the irradiance E(n) (not E/pi) for the normal n through "
                                                         "it; diffuse = albedo E(n) / pi");
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (!checked_) return;
         const auto t0 = std::chrono::steady_clock::now();
         c_.level = level_at_most(ctx.source, brute_face(ctx));
@@ -343,7 +344,7 @@ public:
             f.push_back({std::string("irradiance_") + face_names[face] + ".exr",
                          [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0), attrs_); }});
         f.push_back({"irradiance.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_named(format_), "ibl-bake " + version_string(),
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_of(format_), "ibl-bake " + version_string(),
                                             attrs_);
                      }});
         return f;
@@ -371,7 +372,7 @@ public:
 
 private:
     int size_ = 32, max_face_ = 32;
-    std::string format_;
+    ktx2_storage format_ = ktx2_storage::rgba16f;
     std::vector<std::pair<std::string, std::string>> attrs_;
     const ibl::cubemap<float>* map_ = nullptr;
     double ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;

@@ -58,15 +58,15 @@ public:
     stage_kind kind() const override { return stage_kind::product; }
     const char* category() const override { return "lobe_lut"; }
     bool enabled(const bake_context& ctx) const override {
-        return ctx.lut && ctx.chain && runtime_model_of(ctx.opt, ctx.plan).name == "lobe";
+        return ctx.lut && ctx.chain && runtime_model_of(ctx.opt, ctx.plan).kind == runtime_choice::lobe;
     }
     double product_ms() const override { return ms_; }
     double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
-        layout_ = dfg_layout_named(ctx.opt.dfg_layout);
-        weight_name_ = ctx.opt.ld_weight;
-        weight_ = ld_weight_named(ctx.opt.ld_weight);
+        layout_ = ctx.opt.dfg_layout;
+        weight_name_ = to_string(ctx.opt.ld_weight);
+        weight_ = ctx.opt.ld_weight;
         const auto size = std::uint32_t(lobe_lut_size_for(ctx.plan.dfg.size));
         ctx.prog.begin("lobe lut");
         {
@@ -91,7 +91,7 @@ public:
                                      "unit tangent of n towards R; specular = F0 A LD(normalize(mix(n, R, s)), r_eff) + F90 B "
                                      "LD(d_B, r_B) with (A, B, s, r_eff) from lobe_lut.exr",
                                      layout_, keys);
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (!checked_) return;
         ctx.prog.begin("check lobe lut");
         ab_max_abs_ = ab_vs_dfg(lut_->data, lut_->size, 4, layout_, *ctx.lut);

@@ -59,15 +59,15 @@ public:
     stage_kind kind() const override { return stage_kind::product; }
     const char* category() const override { return "lobe_lut"; }
     bool enabled(const bake_context& ctx) const override {
-        return ctx.lut && ctx.chain && runtime_model_of(ctx.opt, ctx.plan).name == "taps2";
+        return ctx.lut && ctx.chain && runtime_model_of(ctx.opt, ctx.plan).kind == runtime_choice::taps2;
     }
     double product_ms() const override { return ms_; }
     double check_ms() const override { return check_ms_; }
 
     void run(bake_context& ctx) override {
-        layout_ = dfg_layout_named(ctx.opt.dfg_layout);
-        weight_name_ = ctx.opt.ld_weight;
-        weight_ = ld_weight_named(ctx.opt.ld_weight);
+        layout_ = ctx.opt.dfg_layout;
+        weight_name_ = to_string(ctx.opt.ld_weight);
+        weight_ = ctx.opt.ld_weight;
         const auto size = std::uint32_t(lobe_lut_size_for(ctx.plan.dfg.size));
         ctx.prog.begin("lobe taps");
         ctx.taps = ibl::make_lobe_taps_lut<bake_model>(size, layout_, weight_, fit_options(), ctx.ex);
@@ -79,10 +79,10 @@ public:
                                    "(ibl_specular_lobe_taps2)",
                                    layout_, {{"ibl.ld_weight", weight_name_}});
         checks_ = ctx.opt.checks;
-        if (checks_ == "none") return;
+        if (checks_ == check_mode::none) return;
         ctx.prog.begin("check lobe taps");
         ab_max_abs_ = ab_vs_dfg(lut_->data, lut_->size, lut_->channels, layout_, *ctx.lut);
-        check_midpoints(ctx.ex, checks_ == "full");
+        check_midpoints(ctx.ex, checks_ == check_mode::full);
         check_ms_ = ctx.prog.end();
     }
 
@@ -91,8 +91,8 @@ public:
         const std::string method = std::string("L1 fit of two kernels, ") + bake_model::name + ", chain weight " + weight_name_;
         const std::string cost = std::to_string(lut_->size) + "^2, " + std::to_string(o.nodes) + "^2 points/texel";
         const std::string fit = fmt2("fit L1 mean %.3g, max %.3g", lut_->mean_l1, lut_->max_l1);
-        if (checks_ == "none") return {table_row{"lobe taps", method, cost, ms_, fit}.compact("L1 fit, two kernels", fmt("fit L1 mean %.3g", lut_->mean_l1))};
-        const bool fits = checks_ == "full";
+        if (checks_ == check_mode::none) return {table_row{"lobe taps", method, cost, ms_, fit}.compact("L1 fit, two kernels", fmt("fit L1 mean %.3g", lut_->mean_l1))};
+        const bool fits = checks_ == check_mode::full;
         return {table_row{"lobe taps", method, cost, ms_,
                           fit + fmt("; A,B vs dfg max abs %.3g", ab_max_abs_) + fmt("; midpoint L1 table %.3g", l1_.table_mean) +
                               (fits ? fmt(", direct fit %.3g", l1_.fit_mean) : std::string())}
@@ -107,7 +107,7 @@ private:
     void report_check(json_writer& j) const;
 
     const ibl::lobe_taps_lut* lut_ = nullptr;
-    std::string checks_ = "fast";
+    check_mode checks_ = check_mode::fast;
     ibl::dfg_lut_layout layout_{};
     std::vector<std::pair<std::string, std::string>> attrs_;
     ibl::ld_weight weight_ = ibl::ld_weight::g1;
@@ -209,17 +209,17 @@ void lobe_taps_stage::report(json_writer& j) const {
 
 void lobe_taps_stage::report_check(json_writer& j) const {
     j.key("check").begin_object();
-    j.key("ran").value(checks_ != "none");
-    if (checks_ == "none") { // --checks none
+    j.key("ran").value(checks_ != check_mode::none);
+    if (checks_ == check_mode::none) { // --checks none
         j.end_object();
         return;
     }
-    j.key("direct_fits").value(checks_ == "full");
+    j.key("direct_fits").value(checks_ == check_mode::full);
     j.key("ab_vs_dfg_max_abs").value(ab_max_abs_);
     j.key("midpoints").value(cells_);
     j.key("l1").begin_object();
     j.key("table_mean").value(l1_.table_mean);
-    if (checks_ == "full") { // --checks fast leaves out the direct fits
+    if (checks_ == check_mode::full) { // --checks fast leaves out the direct fits
         j.key("direct_fit_mean").value(l1_.fit_mean);
         j.key("excess_max").value(l1_.excess_max).key("worst_n_dot_v").value(l1_.worst_n_dot_v);
         j.key("worst_roughness").value(l1_.worst_roughness);

@@ -45,11 +45,11 @@ public:
     void run(bake_context& ctx) override {
         ctx.prog.begin("check lookups");
         const auto t0 = std::chrono::steady_clock::now();
-        weight_ = ld_weight_named(ctx.opt.ld_weight); // every reference takes the chain's weight
+        weight_ = ctx.opt.ld_weight; // every reference takes the chain's weight
         // --checks fast: the roughness midway between adjacent levels (where the lookup's error
         // peaks; on a level it is that level's error, which the specular check measures), the
         // chosen lookup only, texel sums of 4 texels per alpha
-        fast_ = ctx.opt.checks == "fast";
+        fast_ = ctx.opt.checks == check_mode::fast;
         texels_per_alpha_ = fast_ ? 4.0 : 8.0;
         const auto& lv = ctx.plan.specular.levels;
         if (fast_)
@@ -57,16 +57,16 @@ public:
         else
             for (int k = 1; k <= 20; ++k) roughness_.push_back(0.05 * k);
         dirs_ = ibl::lookup_error_directions(ctx.qs.ref_grid, ctx.light);
-        ibl::specular_lookup_desc chosen = specular_lookup_named(ctx.opt.specular_lookup);
+        ibl::specular_lookup_desc chosen = ctx.opt.specular_lookup;
         chosen.mapping = ctx.plan.specular.policy.mapping;
         const std::vector<unsigned char> bytes =
-            encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain), ktx2_format_named(ctx.opt.ktx2_format), "check");
+            encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain), ktx2_format_of(ctx.opt.ktx2_format), "check");
         const ibl::cubemap<float> stored = cubemap_from_rgb32f(decode_ktx2_cubemap(bytes, "specular.ktx2"));
-        const bool textbook = ctx.opt.specular_lookup == "textbook";
-        ibl::specular_lookup_desc other = specular_lookup_named(textbook ? "accurate" : "textbook");
+        const bool textbook = textbook_lookup(ctx.opt.specular_lookup);
+        ibl::specular_lookup_desc other = textbook ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
         other.mapping = chosen.mapping;
         const std::string chosen_name = textbook ? "textbook (chosen)" : "log-geometric (chosen)";
-        const std::string stored_name = "as stored in specular.ktx2 (" + ctx.opt.ktx2_format + ")";
+        const std::string stored_name = "as stored in specular.ktx2 (" + std::string(to_string(ctx.opt.ktx2_format)) + ")";
         if (ctx.sun) { // the chain is the residual: measure what the runtime adds up (with the sun) against the whole
             sets_.push_back(with_sun(ctx, *ctx.chain, chosen, chosen_name + " + sun"));
             if (fast_) return finish(ctx, t0);

@@ -73,7 +73,7 @@ public:
     void run(bake_context& ctx) override {
         ctx.set.levels = ctx.opt.levels > 0 ? ctx.opt.levels : auto_levels(ctx.opt.size);
         ctx.set.max_base_size = ctx.opt.size;
-        ctx.set.policy = ctx.opt.policy == "filament" ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
+        ctx.set.policy = ctx.opt.policy;
         ctx.full = tool_full_plan(ctx.set, ctx.qs, ctx.opt.lut_size);
         ctx.scene_mode = !ctx.opt.scene.empty();
         if (ctx.scene_mode) {
@@ -120,11 +120,15 @@ private:
     ibl::bake_plan plan_, full_;
     ibl::plan_cost est_, est_full_;
     std::vector<std::string> omitted_;
-    std::string scene_file_, scene_name_, specular_lookup_, dfg_layout_, runtime_diffuse_;
+    std::string scene_file_, scene_name_, runtime_diffuse_;
+    ibl::specular_lookup_desc specular_lookup_{};
+    ibl::dfg_lut_layout dfg_layout_{};
     runtime_model runtime_;
     int levels_ = 1;
     bool sheen_ = false, mirror_ = false;
-    std::string policy_, preset_, dfg_channels_;
+    ibl::roughness_mip_policy policy_{};
+    bake_preset preset_ = bake_preset::standard;
+    dfg_channel_order dfg_channels_ = dfg_channel_order::ab;
 };
 
 std::vector<std::string> plan_stage::notes_before() const {
@@ -163,13 +167,13 @@ void plan_stage::report(json_writer& j) const {
         j.key("error_target").value(plan_.error_target);
         j.key("diffuse_error_target").value(plan_.diffuse_error_target);
     }
-    j.key("runtime_lookup").value(std::string(policy_ == "filament" ? "lod = r (2 - r) * " : "lod = r * ") + std::to_string(levels_ - 1) +
+    j.key("runtime_lookup").value(std::string(policy_.mapping == ibl::roughness_mapping::filament ? "lod = r (2 - r) * " : "lod = r * ") + std::to_string(levels_ - 1) +
                                   " - " + std::to_string(plan_.specular.first_level) +
                                   " (the policy over the virtual chain, minus the first stored level), clamped to the stored levels");
     j.key("runtime").begin_object(); // what a loader (and ibl-bake --lookup) needs
-    j.key("policy").value(policy_);
-    j.key("preset").value(preset_);
-    j.key("dfg_channels_layout").value(dfg_channels_ == "filament" ? "B, A + B, k (mix(dfg.x, dfg.y, f0))" : "A, B, k");
+    j.key("policy").value(to_string(policy_));
+    j.key("preset").value(to_string(preset_));
+    j.key("dfg_channels_layout").value(dfg_channels_ == dfg_channel_order::filament ? "B, A + B, k (mix(dfg.x, dfg.y, f0))" : "A, B, k");
     j.key("mirrored").value(mirror_);
     j.key("virtual_levels").value(plan_.specular.virtual_levels);
     j.key("first_level").value(plan_.specular.first_level);
@@ -179,7 +183,7 @@ void plan_stage::report(json_writer& j) const {
     j.key("dfg_size").value(plan_.dfg.size);
     j.key("dfg_channels").value(plan_.dfg.channels);
     j.key("sheen").value(sheen_);
-    json_lookup_conventions(j, specular_lookup_named(specular_lookup_), dfg_layout_named(dfg_layout_), runtime_);
+    json_lookup_conventions(j, specular_lookup_, dfg_layout_, runtime_);
     j.end_object();
     j.key("products");
     plan_json(j, plan_, est_);

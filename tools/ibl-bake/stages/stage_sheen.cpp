@@ -62,7 +62,7 @@ public:
         attrs_ = product_conventions(ctx, "sheen", "level l holds the Charlie-lobe LD at roughness l / (levels - 1) (linear), read "
                                                    "at R by textureLod(chain, R, lod(r))");
         lut_attrs_ = table_conventions(ctx, "sheen_lut", "R = sheen albedo E(n.v, r) (Charlie NDF, Neubelt visibility)", lut_.layout);
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (!checked_) return;
         ctx.prog.begin("check sheen");
         const auto t0 = std::chrono::steady_clock::now();
@@ -98,7 +98,7 @@ public:
                 f.push_back({"sheen_l" + std::to_string(l) + "_" + face_names[face] + ".exr",
                              [this, l, face](const std::string& p) { write_exr(p, face_image(chain_, face, l), attrs_); }});
         f.push_back({"sheen.ktx2", [this](const std::string& p) {
-                         write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_named(format_), "ibl-bake " + version_string(),
+                         write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_of(format_), "ibl-bake " + version_string(),
                                             attrs_);
                      }});
         f.push_back({"sheen_lut.exr", [this](const std::string& p) {
@@ -145,7 +145,7 @@ private:
     ibl::cubemap<float> chain_{1};
     const ibl::disk_light<double>* sun_ = nullptr;
     ibl::dfg_lut lut_;
-    std::string format_;
+    ktx2_storage format_ = ktx2_storage::rgba16f;
     std::vector<std::uint32_t> samples_;
     std::vector<ibl::error_metrics> levels_;
     double ms_ = 0.0, check_ms_ = 0.0, lut_max_abs_ = 0.0;

@@ -27,6 +27,11 @@ namespace {
 
 constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 reference texel mean
 
+/// The roughness <-> lod rule of a policy, as the files and report.json state it.
+const char* policy_rule(ibl::roughness_mip_policy p) {
+    return p.mapping == ibl::roughness_mapping::filament ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r";
+}
+
 /// What a loader needs, in the KTX2's key/value data: the level -> roughness mapping, the first
 /// stored level of the virtual chain, the policy, the lookup, the preset, the chain's LD weight
 /// and the runtime model (lobe: read with lobe_lut.exr; taps2: with lobe_taps_a.exr and
@@ -38,21 +43,21 @@ std::vector<std::pair<std::string, std::string>> chain_metadata(const bake_conte
         if (!r.empty()) r.push_back(' ');
         r.append(fmt("%.9g", l.roughness));
     }
-    const std::string lookup = ctx.opt.specular_lookup == "accurate"
-                                   ? "the two levels bracketing r blended log-geometrically (ibl_specular_lookup)"
-                                   : "textureLod(chain, R, lod(r))";
+    const std::string lookup = textbook_lookup(ctx.opt.specular_lookup)
+                                   ? "textureLod(chain, R, lod(r))"
+                                   : "the two levels bracketing r blended log-geometrically (ibl_specular_lookup)";
     std::vector<std::pair<std::string, std::string>> m =
         product_conventions(ctx, "specular",
                             std::string("level l holds LD at roughness ibl.level_roughness[l], weight ") +
-                                (ctx.opt.ld_weight == "g1" ? "D G1 (the specular lobe at n.v = 1)" : "D n.l (Karis)") +
+                                (ctx.opt.ld_weight == ibl::ld_weight::g1 ? "D G1 (the specular lobe at n.v = 1)" : "D n.l (Karis)") +
                                 "; read at R = reflect(-v, n) by " + lookup);
     for (auto kv : std::vector<std::pair<std::string, std::string>>{
              {"ibl.first_level", std::to_string(sp.first_level)},
-             {"ibl.ld_weight", ctx.opt.ld_weight},
+             {"ibl.ld_weight", to_string(ctx.opt.ld_weight)},
              {"ibl.level_roughness", r},
-             {"ibl.policy", ctx.opt.policy == "filament" ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r"},
-             {"ibl.runtime", runtime_model_of(ctx.opt, ctx.plan).name},
-             {"ibl.specular_lookup", ctx.opt.specular_lookup},
+             {"ibl.policy", policy_rule(ctx.opt.policy)},
+             {"ibl.runtime", to_string(runtime_model_of(ctx.opt, ctx.plan).kind)},
+             {"ibl.specular_lookup", ctx.opt.specular_lookup.name()},
              {"ibl.virtual_levels", std::to_string(sp.virtual_levels)}})
         m.push_back(kv);
     return m;
@@ -79,7 +84,7 @@ public:
 
     void run(bake_context& ctx) override {
         ctx.prog.begin("prefilter");
-        weight_ = ld_weight_named(ctx.opt.ld_weight);
+        weight_ = ctx.opt.ld_weight;
         ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex);
         ms_ = ctx.prog.end();
         chain_ = &*ctx.chain;
@@ -90,10 +95,10 @@ public:
         metadata_ = chain_metadata(ctx);
         layouts_ = ctx.opt.layouts;
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
-        checked_ = ctx.opt.checks != "none";
+        checked_ = ctx.opt.checks != check_mode::none;
         if (!checked_) return;
         ctx.prog.begin("check specular");
-        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_named(format_));
+        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_of(format_));
         for (int k = 0; k < chain_->levels(); ++k) {
             ctx.prog.label("level " + std::to_string(k) + "/" + std::to_string(chain_->levels() - 1));
             checks_.push_back(check_level(ctx, k));
@@ -112,8 +117,8 @@ private:
     const ibl::cubemap<float>* chain_ = nullptr;
     ibl::specular_plan sp_;
     bool analytic_ = true;
-    std::string format_;
-    std::vector<std::string> layouts_;
+    ktx2_storage format_ = ktx2_storage::rgba16f;
+    std::vector<level_layout> layouts_;
     std::vector<ktx2_quantisation_level> quant_;
     std::vector<std::pair<std::string, std::string>> metadata_;
     /// The chain's keys plus the level and its roughness (ibl.level, ibl.roughness).
@@ -200,9 +205,9 @@ std::vector<table_row> specular_stage::rows() const {
         qmax = std::max(qmax, q.max_rel_error), qrms = std::max(qrms, q.rms_rel_error);
         clamped += q.above_range + q.negative_clamped + q.nan;
     }
-    table_row q{"  specular.ktx2", format_ + " storage vs float", std::to_string(quant_.size()) + " levels", -1.0,
+    table_row q{"  specular.ktx2", std::string(to_string(format_)) + " storage vs float", std::to_string(quant_.size()) + " levels", -1.0,
                 fmt2("max rel %.3g, worst level rms rel %.3g", qmax, qrms) + ", " + std::to_string(clamped) + " values clamped"};
-    q.compact(format_ + " storage", fmt("max rel %.3g, ", qmax) + std::to_string(clamped) + " clamped");
+    q.compact(std::string(to_string(format_)) + " storage", fmt("max rel %.3g, ", qmax) + std::to_string(clamped) + " clamped");
     if (clamped > 0)
         q.meaning = "values beyond the format's range were clamped: --ktx2-format rgba32f stores them (or scale the input)";
     else
@@ -223,25 +228,25 @@ std::vector<table_row> specular_stage::rows() const {
 
 std::vector<file_out> specular_stage::files() const {
     std::vector<file_out> f;
-    const auto has = [&](const char* l) { return std::find(layouts_.begin(), layouts_.end(), l) != layouts_.end(); };
+    const auto has = [&](level_layout l) { return std::find(layouts_.begin(), layouts_.end(), l) != layouts_.end(); };
     for (int l = 0; l < chain_->levels(); ++l) {
         const std::string base = "specular_l" + std::to_string(l) + "_";
-        if (has("faces"))
+        if (has(level_layout::faces))
             for (int face = 0; face < 6; ++face)
                 f.push_back({base + face_names[face] + ".exr",
                              [this, l, face](const std::string& p) { write_exr(p, face_image(*chain_, face, l), level_attrs(l)); }});
-        if (has("latlong"))
+        if (has(level_layout::latlong))
             f.push_back({base + "latlong.exr", [this, l](const std::string& p) { write_exr(p, latlong_from_cube(*chain_, l), level_attrs(l)); }});
-        if (has("cross"))
+        if (has(level_layout::cross))
             f.push_back({base + "cross.exr", [this, l](const std::string& p) {
                              write_exr(p, cross_from_faces(faces_from_cubemap(*chain_, l)), level_attrs(l));
                          }});
-        if (has("octahedral"))
+        if (has(level_layout::octahedral))
             f.push_back({base + "octahedral.exr",
                          [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l), level_attrs(l)); }});
     }
     f.push_back({"specular.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, cubemap_to_rgb32f(*chain_), ktx2_format_named(format_), "ibl-bake " + version_string(), metadata_);
+                     write_ktx2_cubemap(p, cubemap_to_rgb32f(*chain_), ktx2_format_of(format_), "ibl-bake " + version_string(), metadata_);
                  }});
     return f;
 }
@@ -251,7 +256,7 @@ void specular_stage::report(json_writer& j) const {
     j.key("files").value("specular_l{level}_{px,nx,py,ny,pz,nz}.exr (layout faces), specular_l{level}_{latlong,cross,octahedral}.exr "
                          "(those layouts), specular.ktx2");
     j.key("layouts").begin_array();
-    for (const auto& l : layouts_) j.value(l);
+    for (const auto& l : layouts_) j.value(to_string(l));
     j.end_array();
     j.key("ktx2_quantisation");
     if (checked_) json_quantisation(j, quant_, format_);
@@ -259,7 +264,7 @@ void specular_stage::report(json_writer& j) const {
     j.key("method").value(std::string("GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
-    j.key("ld_weight").value(weight_ == ibl::ld_weight::g1 ? "g1" : "nl");
+    j.key("ld_weight").value(to_string(weight_));
     j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? sp_.levels[1].samples : 0u);
     j.key("samples_per_level").begin_array();
     for (const auto& l : sp_.levels) j.value(l.samples);

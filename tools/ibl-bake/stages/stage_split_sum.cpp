@@ -107,7 +107,7 @@ public:
         const std::vector<view_geom> views = make_views(ctx.light);
         nviews_ = views.size();
         const product_view bp = baked_view(ctx);
-        model_ = bp.taps ? "taps2" : bp.lobe ? "lobe" : "split-sum";
+        model_ = bp.taps ? runtime_choice::taps2 : bp.lobe ? runtime_choice::lobe : runtime_choice::split_sum;
         for (const material_case& mc : k_materials)
             for (const double r : k_roughness) {
                 ctx.prog.label(std::string(mc.name) + fmt(" r=%.1f", r));
@@ -127,7 +127,7 @@ private:
 
     std::uint32_t samples_ = 0;
     std::size_t nviews_ = 0;
-    std::string model_ = "split-sum"; ///< the runtime model measured beside the plain split sum
+    runtime_choice model_ = runtime_choice::split_sum; ///< the runtime model measured beside the plain split sum
     std::vector<split_result> results_;
 };
 
@@ -164,25 +164,25 @@ split_result split_sum_stage::measure(const bake_context& ctx, const ibl::cube_e
 
 namespace {
 /// What an alarming error of a runtime model against the full integral means.
-std::string model_meaning(const std::string& model) {
-    if (model == "split-sum") return "the split-sum approximation's own error, not a bake defect: --runtime lobe/taps2 lower it";
-    if (model == "lobe") return "the lobe model's own error vs the full integral, not a bake defect: --runtime taps2 lowers it";
+std::string model_meaning(runtime_choice model) {
+    if (model == runtime_choice::split_sum) return "the split-sum approximation's own error, not a bake defect: --runtime lobe/taps2 lower it";
+    if (model == runtime_choice::lobe) return "the lobe model's own error vs the full integral, not a bake defect: --runtime taps2 lowers it";
     return "the two-tap model's own error vs the full integral, not a bake defect (docs/runtime.md)";
 }
 } // namespace
 
 std::vector<table_row> split_sum_stage::rows() const {
     std::vector<table_row> rows;
-    auto name_of = [](const std::string& model) { return std::string(model == "split-sum" ? "split sum " : model == "lobe" ? "lobe lut " : "taps2 "); };
-    auto method_of = [](const std::string& model) {
-        return model == "split-sum" ? "baked LD+DFG+SH vs MIS reference"
-               : model == "lobe"    ? "baked F0 A LD(d_A)+F90 B LD(d_B)+SH vs MIS"
+    auto name_of = [](runtime_choice model) { return std::string(model == runtime_choice::split_sum ? "split sum " : model == runtime_choice::lobe ? "lobe lut " : "taps2 "); };
+    auto method_of = [](runtime_choice model) {
+        return model == runtime_choice::split_sum ? "baked LD+DFG+SH vs MIS reference"
+               : model == runtime_choice::lobe    ? "baked F0 A LD(d_A)+F90 B LD(d_B)+SH vs MIS"
                                     : "baked 2 x LD(d_k, r_k)+taps LUT+SH vs MIS";
     };
-    auto row = [&](const split_result& res, const model_result& m, const std::string& model) {
+    auto row = [&](const split_result& res, const model_result& m, runtime_choice model) {
         double se = 0.0;
         for (const auto& v : m.views) se = std::max(se, v.se_rel);
-        const bool plain = model == "split-sum";
+        const bool plain = model == runtime_choice::split_sum;
         std::string cmp;
         if (!plain)
             cmp = fmt2("; vs split sum %+.2f%% (noise %.2f%%)", 100.0 * res.excess(), 100.0 * res.noise()) +
@@ -196,7 +196,7 @@ std::vector<table_row> split_sum_stage::rows() const {
         rows.push_back(r);
     };
     // the compact table: per model and material the worst max |rel| over the roughness values
-    auto summary = [&](const std::string& model, bool runtime) {
+    auto summary = [&](runtime_choice model, bool runtime) {
         for (const material_case& mc : k_materials) {
             double worst = -1.0, at = 0.0, se = 0.0, ms = 0.0;
             int worse = 0; // roughness values where the runtime model is worse than the split sum beyond noise
@@ -209,9 +209,9 @@ std::vector<table_row> split_sum_stage::rows() const {
                 ms += res.ms;
             }
             if (worst < 0.0) continue;
-            table_row r{name_of(model) + mc.name, method_of(model), std::to_string(nviews_) + " views x 3 r", model == "split-sum" ? ms : -1.0,
+            table_row r{name_of(model) + mc.name, method_of(model), std::to_string(nviews_) + " views x 3 r", model == runtime_choice::split_sum ? ms : -1.0,
                         ""};
-            r.compact(model == "split-sum" ? "LD+DFG+SH vs MIS" : model == "lobe" ? "lobe LUT+SH vs MIS" : "2 taps+SH vs MIS",
+            r.compact(model == runtime_choice::split_sum ? "LD+DFG+SH vs MIS" : model == runtime_choice::lobe ? "lobe LUT+SH vs MIS" : "2 taps+SH vs MIS",
                       fmt2("max |rel| %.3g%% (r=%.1f)", 100.0 * worst, at) + fmt(", ref se %.2f%%", 100.0 * se) +
                           (worse > 0 ? std::string(", WORSE than split sum") : std::string()))
                 .alarm(worst, alarm_relative, model_meaning(model));
@@ -219,10 +219,10 @@ std::vector<table_row> split_sum_stage::rows() const {
             rows.push_back(r);
         }
     };
-    summary("split-sum", false);
-    if (model_ != "split-sum") summary(model_, true);
-    for (const auto& res : results_) row(res, res.plain, "split-sum");
-    if (model_ != "split-sum")
+    summary(runtime_choice::split_sum, false);
+    if (model_ != runtime_choice::split_sum) summary(model_, true);
+    for (const auto& res : results_) row(res, res.plain, runtime_choice::split_sum);
+    if (model_ != runtime_choice::split_sum)
         for (const auto& res : results_) row(res, res.runtime, model_);
     return rows;
 }
@@ -240,11 +240,11 @@ void split_sum_stage::report(json_writer& j) const {
                           "mean_abs_rel from the reference's (sqrt(sum_views ((1 + rel) reference_rel_std_error)^2) / "
                           "views); vs_split_sum (materials): excess = mean_abs_rel - the split sum's, noise = 2 "
                           "sqrt(se^2 + se_split_sum^2), worse = excess > noise");
-    j.key("runtime_model").value(model_);
+    j.key("runtime_model").value(to_string(model_));
     j.key("samples_per_view").value(samples_);
     std::size_t worse = 0;
     for (const auto& s : results_) worse += s.worse() ? 1 : 0;
-    j.key("runtime_worse_than_split_sum").value(std::uint64_t(model_ == "split-sum" ? 0 : worse));
+    j.key("runtime_worse_than_split_sum").value(std::uint64_t(model_ == runtime_choice::split_sum ? 0 : worse));
     report_model(j, true);
     report_model(j, false);
     j.end_object();
@@ -261,7 +261,7 @@ void split_sum_stage::report_model(json_writer& j, bool runtime) const {
         if (runtime) {
             j.key("vs_split_sum").begin_object();
             j.key("split_sum_mean_abs_rel").value(s.plain.mean_abs_rel).key("split_sum_std_error").value(s.plain.mean_abs_rel_se());
-            j.key("excess").value(s.excess()).key("noise").value(s.noise()).key("worse").value(model_ != "split-sum" && s.worse());
+            j.key("excess").value(s.excess()).key("noise").value(s.noise()).key("worse").value(model_ != runtime_choice::split_sum && s.worse());
             j.end_object();
         }
         j.key("views").begin_array();

@@ -23,7 +23,7 @@ public:
     const char* category() const override { return "source"; }
     /// auto: the full bake only (a scene plan's error tables were measured without extraction).
     bool enabled(const bake_context& ctx) const override {
-        return ctx.opt.extract_sun == "on" || (ctx.opt.extract_sun == "auto" && !ctx.scene_mode);
+        return ctx.opt.extract_sun == sun_extraction::on || (ctx.opt.extract_sun == sun_extraction::automatic && !ctx.scene_mode);
     }
     double product_ms() const override { return ms_; }
 
@@ -37,7 +37,7 @@ public:
             ctx.sun = ibl::disk_light<double>{dvec3(ext_.direction), double(ext_.solid_angle), dvec3(ext_.radiance)};
         }
         ms_ = ctx.prog.end();
-        required_ = ctx.opt.extract_sun == "on";
+        required_ = ctx.opt.extract_sun == sun_extraction::on;
     }
 
     std::vector<table_row> rows() const override {

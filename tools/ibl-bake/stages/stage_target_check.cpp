@@ -146,7 +146,7 @@ void target_check_stage::run(bake_context& ctx) {
     for (const auto& p : pts) dirs.push_back(2.0 * glm::dot(p.n, p.v) * p.n - p.v);
     const std::size_t nd = dirs.size();
     std::vector<dvec3> conv(std::size_t(stored) * nd, dvec3(0.0)), rough(conv.size(), dvec3(0.0));
-    const ibl::ld_weight w = ld_weight_named(ctx.opt.ld_weight);
+    const ibl::ld_weight w = ctx.opt.ld_weight;
     for (int k = 0; k < stored; ++k) {
         if (!read[std::size_t(k)]) continue;
         const ibl::specular_level_plan& lp = sp.levels[std::size_t(k)];

@@ -121,17 +121,17 @@ struct product_view {
     dvec3 irradiance(const dvec3& n) const;
 };
 
-/// The DFG table layout, the specular lookup and the LD weight named by --dfg-layout /
-/// --specular-lookup / --ld-weight (g1 | nl).
-ibl::dfg_lut_layout dfg_layout_named(const std::string& name);
-ibl::specular_lookup_desc specular_lookup_named(const std::string& name);
-ibl::ld_weight ld_weight_named(const std::string& name);
+/// Whether a lookup is the textbook one (textureLod at lod(r)): its level weight and blend.
+inline bool textbook_lookup(const ibl::specular_lookup_desc& d) noexcept {
+    constexpr ibl::specular_lookup_desc textbook = ibl::specular_lookup_desc::textbook();
+    return d.weight == textbook.weight && d.interpolation == textbook.interpolation;
+}
 
-/// The runtime model of a bake: "lobe" or "taps2" (with its table's size) or "split-sum".
+/// The runtime model of a bake: lobe or taps2 (with its table's size) or the split sum.
 struct runtime_model {
-    std::string name = "split-sum";
+    runtime_choice kind = runtime_choice::split_sum;
     int lobe_lut_size = 0; ///< texels per side of the lobe LUT or of the two-tap table
-    std::string ld_weight = "nl"; ///< the chain's weight: g1 | nl
+    ibl::ld_weight ld_weight = ibl::ld_weight::n_dot_l; ///< the chain's weight
 };
 /// What the options and the plan give: lobe (taps2) when --runtime lobe (taps2) and the plan has
 /// a DFG table and a chain.
@@ -217,12 +217,12 @@ diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
 image_rgb32f face_image(const ibl::cubemap<float>& cube, int face, int level);
 void write_text(const std::string& path, const std::string& text);
 
-/// The KTX2 format named by --ktx2-format (rgba16f, rgba32f, b10g11r11, e5b9g9r9).
-ktx2_format ktx2_format_named(const std::string& name);
+/// The KTX2 format of a --ktx2-format (the same names).
+ktx2_format ktx2_format_of(ktx2_storage storage);
 
 /// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.
-void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, const std::string& format);
+void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, ktx2_storage format);
 
 /// A square table of `channels` floats per texel as a C header (the layout of dfg.hpp:
 /// name_size, name_channels, name[] row by row, row 0 = the smallest roughness; exact floats):
