@@ -270,7 +270,9 @@ void specular_stage::report(json_writer& j) const {
     for (const auto& l : sp_.levels) j.value(l.samples);
     j.end_array().key("lod_bias").value(0.5).end_object();
     j.key("time_ms").value(ms_);
-    j.key("mip_policy").value("linear: roughness = v / (V - 1) for virtual level v of V; stored level = v - first_level");
+    j.key("mip_policy").value(sp_.policy.mapping == ibl::roughness_mapping::filament
+                                  ? "filament: roughness r at virtual lod v = (V - 1) r (2 - r) of V levels; stored level = v - first_level"
+                                  : "linear: roughness = v / (V - 1) for virtual level v of V; stored level = v - first_level");
     j.key("virtual_levels").value(sp_.virtual_levels);
     j.key("first_level").value(sp_.first_level);
     j.key("check").begin_object();

@@ -58,6 +58,9 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     for (std::size_t l = 0; l < lv.size(); ++l)
         CHECK(lv[l].find("roughness")->number == doctest::Approx(1.0 - std::sqrt(1.0 - double(l) / 3.0)));
     CHECK(fil.find("plan")->find("runtime")->find("policy")->string == "filament");
+    // the specular section names the policy the chain was baked with
+    CHECK(fil.find("specular")->find("mip_policy")->string.rfind("filament: ", 0) == 0);
+    CHECK(ref.find("specular")->find("mip_policy")->string.rfind("linear: ", 0) == 0);
     // the DFG table: filament stores (B, A + B); gltf and the reference (A, B) at texel centres
     const image_rgb32f tf = read_image(s / "fil/dfg.exr"), tr = read_image(s / "ref/dfg.exr"), tg = read_image(s / "gltf/dfg.exr");
     REQUIRE(tf.rgb.size() == tr.rgb.size());
