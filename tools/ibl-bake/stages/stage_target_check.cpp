@@ -101,6 +101,136 @@ struct rel_rms {
     }
 };
 
+/// Which stored levels of the plan's chain the materials' lookups read (1: read).
+std::vector<char> levels_read(const ibl::specular_plan& sp, const std::vector<scene_shading_material>& mats,
+                              const ibl::specular_lookup_desc& lookup) {
+    const int stored = int(sp.levels.size());
+    std::vector<char> read(std::size_t(stored), 0);
+    for (const auto& m : mats) {
+        const ibl::specular_taps<float> t = ibl::specular_lookup_taps(float(m.m.roughness), sp.virtual_levels, lookup);
+        for (int k = 0; k < t.count; ++k) read[std::size_t(std::clamp(t.level[k] - sp.first_level, 0, stored - 1))] = 1;
+    }
+    return read;
+}
+
+/// The converged levels at the reflection directions, only the (level, direction) pairs read:
+/// conv with converged_samples, rough with noise_samples (the noise of conv's estimate), each
+/// [stored level * nd + direction].
+struct converged_chain {
+    const ibl::specular_plan* sp = nullptr;
+    ibl::specular_lookup_desc lookup{};
+    std::size_t nd = 0;
+    std::vector<dvec3> conv, rough;
+
+    /// LD at direction i and roughness r read from `levels` (conv or rough) as the runtime reads the chain.
+    dvec3 ld(const std::vector<dvec3>& levels, std::size_t i, double r) const {
+        const int stored = int(sp->levels.size());
+        const ibl::specular_taps<float> t = ibl::specular_lookup_taps(float(r), sp->virtual_levels, lookup);
+        fvec3 v[4];
+        for (int k = 0; k < t.count; ++k)
+            v[k] = fvec3(levels[std::size_t(std::clamp(t.level[k] - sp->first_level, 0, stored - 1)) * nd + i]);
+        return dvec3(ibl::specular_blend(t, v, lookup));
+    }
+};
+
+converged_chain converge_levels(const bake_context& ctx, const std::vector<char>& read, const std::vector<dvec3>& dirs,
+                                const ibl::specular_lookup_desc& lookup) {
+    const ibl::cubemap<float>& whole = ctx.whole_source();
+    const ibl::specular_plan& sp = ctx.plan.specular;
+    const std::size_t nd = dirs.size();
+    converged_chain c{&sp, lookup, nd, std::vector<dvec3>(sp.levels.size() * nd, dvec3(0.0)), {}};
+    c.rough.assign(c.conv.size(), dvec3(0.0));
+    for (std::size_t k = 0; k < sp.levels.size(); ++k) {
+        if (!read[k]) continue;
+        const ibl::specular_level_plan& lp = sp.levels[k];
+        if (lp.level == 0) {
+            for (std::size_t i = 0; i < nd; ++i) c.conv[k * nd + i] = c.rough[k * nd + i] = dvec3(whole.radiance(fvec3(dirs[i]), 0.0f));
+            continue;
+        }
+        for (int pass = 0; pass < 2; ++pass) {
+            ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
+                whole, lp.roughness, pass == 0 ? converged_samples : noise_samples, ibl::prefilter_method::filtered_importance, 0.5,
+                ctx.opt.ld_weight);
+            table.trilinear = true;
+            std::vector<dvec3>& out = pass == 0 ? c.conv : c.rough;
+            ctx.ex(nd, [&](std::size_t b, std::size_t e) {
+                for (std::size_t i = b; i < e; ++i) out[k * nd + i] = dvec3(ibl::convolve_direction<float>(whole, table, fvec3(dirs[i])));
+            });
+        }
+    }
+    return c;
+}
+
+/// Brute-force irradiance at the normals: of the whole environment and of the source the products
+/// hold (the residual when a sun was extracted).
+struct point_irradiance {
+    std::vector<dvec3> whole, source;
+};
+
+point_irradiance brute_irradiance(const bake_context& ctx, const std::vector<dvec3>& normals) {
+    const ibl::cubemap<float>& whole = ctx.whole_source();
+    point_irradiance e;
+    e.whole = texel_sum_irradiance(whole, level_at_most(whole, 64), normals, ctx.ex);
+    e.source = ctx.sun ? texel_sum_irradiance(ctx.source, level_at_most(ctx.source, 64), normals, ctx.ex) : e.whole;
+    return e;
+}
+
+/// The ambient luminance errors over the materials and points: spec (planned chain + DFG table vs
+/// converged chain + dfg_exact, both with brute-force E), noise (spec's reference against its
+/// noisier twin) and combined (informational: the whole ambient term, planned diffuse included,
+/// vs the converged set, --compare-full's "planned vs converged").
+struct ambient_errors {
+    rel_rms spec, noise, combined;
+};
+
+ambient_errors measure_ambient(const bake_context& ctx, const product_view& planned_full, const converged_chain& cc,
+                               const std::vector<scene_shading_point>& pts, const std::vector<scene_shading_material>& mats,
+                               const point_irradiance& e) {
+    const bool diffuse_lit = ctx.plan.diffuse.kind != ibl::diffuse_product::none;
+    product_view planned = planned_full.split_sum();
+    planned.diffuse = nullptr;
+    ambient_errors r;
+    for (const auto& ms : mats) {
+        const auto shader = ibl::pbr_shader<double>::from(ms.m, ctx.scene.multiscatter);
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+            const dvec3 &n = pts[i].n, &v = pts[i].v;
+            const double nv = std::clamp(glm::dot(n, v), 0.0, 1.0);
+            ibl::ibl_sample<double> sp_plan = planned.sample(n, v, ms.m.roughness);
+            sp_plan.irradiance_over_pi = diffuse_lit ? e.source[i] / ibl::pi_v<double> : dvec3(0.0);
+            dvec3 lo_plan = shader.ambient(nv, sp_plan);
+            if (ctx.sun) lo_plan += ibl::shade_disk(n, v, *ctx.sun, shader.m);
+            ibl::ibl_sample<double> sr;
+            sr.ld = cc.ld(cc.conv, i, ms.m.roughness);
+            sr.dfg = ibl::dfg_exact<bake_model>(nv, ms.m.roughness);
+            sr.irradiance_over_pi = diffuse_lit ? e.whole[i] / ibl::pi_v<double> : dvec3(0.0);
+            const double yr = ibl::luminance(shader.ambient(nv, sr));
+            r.spec.add(ibl::luminance(lo_plan) - yr, yr);
+            ibl::ibl_sample<double> s1 = sr;
+            s1.ld = cc.ld(cc.rough, i, ms.m.roughness);
+            r.noise.add(ibl::luminance(shader.ambient(nv, s1)) - yr, yr);
+            dvec3 lo_all = shader.ambient(nv, planned_full.split_sum().sample(n, v, ms.m.roughness));
+            if (ctx.sun) lo_all += ibl::shade_disk(n, v, *ctx.sun, shader.m);
+            r.combined.add(ibl::luminance(lo_all) - yr, yr);
+        }
+    }
+    return r;
+}
+
+/// The diffuse target: the planned diffuse product's E against brute force over the whole source.
+target_row diffuse_target(const bake_context& ctx, const product_view& planned_full, const std::vector<dvec3>& normals,
+                          const std::vector<dvec3>& e_whole) {
+    rel_rms dif;
+    for (std::size_t i = 0; i < normals.size(); ++i) {
+        const dvec3 ep = planned_full.irradiance(normals[i]);
+        const double er = e_whole[i].x + e_whole[i].y + e_whole[i].z;
+        dif.add(ep.x + ep.y + ep.z - er, er);
+    }
+    target_row td{"diffuse", ctx.plan.diffuse_error_target, dif.value(), 0.0, dif.se(), true,
+                  "RMS(E_product - E) / RMS(E) (RGB sums) over the normals, E by brute force over the source"};
+    td.met = td.measured <= td.target;
+    return td;
+}
+
 class target_check_stage final : public stage {
 public:
     const char* key() const override { return "target_check"; }
@@ -121,105 +251,27 @@ private:
 void target_check_stage::run(bake_context& ctx) {
     ctx.prog.begin("scene targets");
     const auto t0 = std::chrono::steady_clock::now();
-    const ibl::cubemap<float>& whole = ctx.whole_source();
     const std::vector<scene_shading_point> pts = scene_shading_points();
     const std::vector<scene_shading_material> mats = scene_shading_materials(ctx.scene);
-    const bool diffuse_lit = ctx.plan.diffuse.kind != ibl::diffuse_product::none;
-    std::vector<dvec3> normals;
-    for (const auto& p : pts) normals.push_back(p.n);
-    const std::vector<dvec3> e_whole = texel_sum_irradiance(whole, level_at_most(whole, 64), normals, ctx.ex);
-    const std::vector<dvec3> e_source =
-        ctx.sun ? texel_sum_irradiance(ctx.source, level_at_most(ctx.source, 64), normals, ctx.ex) : e_whole;
-
-    // the converged levels at the reflection directions, only the (level, direction) pairs read
+    std::vector<dvec3> normals, dirs;
+    for (const auto& p : pts) {
+        normals.push_back(p.n);
+        dirs.push_back(2.0 * glm::dot(p.n, p.v) * p.n - p.v);
+    }
+    const point_irradiance e = brute_irradiance(ctx, normals);
     const product_view planned_full = baked_view(ctx); // with the sun, for the runtime's E
-    product_view planned = planned_full.split_sum();
-    planned.diffuse = nullptr;
-    const ibl::specular_plan& sp = ctx.plan.specular;
-    const int stored = int(sp.levels.size());
-    std::vector<char> read(std::size_t(stored), 0);
-    for (const auto& m : mats) {
-        const ibl::specular_taps<float> t = ibl::specular_lookup_taps(float(m.m.roughness), sp.virtual_levels, planned.specular);
-        for (int k = 0; k < t.count; ++k) read[std::size_t(std::clamp(t.level[k] - sp.first_level, 0, stored - 1))] = 1;
-    }
-    std::vector<dvec3> dirs;
-    for (const auto& p : pts) dirs.push_back(2.0 * glm::dot(p.n, p.v) * p.n - p.v);
-    const std::size_t nd = dirs.size();
-    std::vector<dvec3> conv(std::size_t(stored) * nd, dvec3(0.0)), rough(conv.size(), dvec3(0.0));
-    const ibl::ld_weight w = ctx.opt.ld_weight;
-    for (int k = 0; k < stored; ++k) {
-        if (!read[std::size_t(k)]) continue;
-        const ibl::specular_level_plan& lp = sp.levels[std::size_t(k)];
-        directions_ += nd;
-        if (lp.level == 0) {
-            for (std::size_t i = 0; i < nd; ++i) conv[std::size_t(k) * nd + i] = rough[std::size_t(k) * nd + i] = dvec3(whole.radiance(fvec3(dirs[i]), 0.0f));
-            continue;
-        }
-        for (int pass = 0; pass < 2; ++pass) {
-            ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
-                whole, lp.roughness, pass == 0 ? converged_samples : noise_samples, ibl::prefilter_method::filtered_importance, 0.5, w);
-            table.trilinear = true;
-            std::vector<dvec3>& out = pass == 0 ? conv : rough;
-            ctx.ex(nd, [&](std::size_t b, std::size_t e) {
-                for (std::size_t i = b; i < e; ++i)
-                    out[std::size_t(k) * nd + i] = dvec3(ibl::convolve_direction<float>(whole, table, fvec3(dirs[i])));
-            });
-        }
-    }
-    auto conv_ld = [&](const std::vector<dvec3>& levels, std::size_t i, double r) {
-        const ibl::specular_taps<float> t = ibl::specular_lookup_taps(float(r), sp.virtual_levels, planned.specular);
-        fvec3 v[4];
-        for (int k = 0; k < t.count; ++k)
-            v[k] = fvec3(levels[std::size_t(std::clamp(t.level[k] - sp.first_level, 0, stored - 1)) * nd + i]);
-        return dvec3(ibl::specular_blend(t, v, planned.specular));
-    };
-
-    // specular: planned chain + DFG table vs converged chain + dfg_exact, both with brute-force E
-    rel_rms spec, noise, combined;
-    for (const auto& ms : mats) {
-        const auto shader = ibl::pbr_shader<double>::from(ms.m, ctx.scene.multiscatter);
-        for (std::size_t i = 0; i < pts.size(); ++i) {
-            const dvec3 &n = pts[i].n, &v = pts[i].v;
-            const double nv = std::clamp(glm::dot(n, v), 0.0, 1.0);
-            ibl::ibl_sample<double> sp_plan = planned.sample(n, v, ms.m.roughness);
-            sp_plan.irradiance_over_pi = diffuse_lit ? e_source[i] / ibl::pi_v<double> : dvec3(0.0);
-            dvec3 lo_plan = shader.ambient(nv, sp_plan);
-            if (ctx.sun) lo_plan += ibl::shade_disk(n, v, *ctx.sun, shader.m);
-            ibl::ibl_sample<double> sr;
-            sr.ld = conv_ld(conv, i, ms.m.roughness);
-            sr.dfg = ibl::dfg_exact<bake_model>(nv, ms.m.roughness);
-            sr.irradiance_over_pi = diffuse_lit ? e_whole[i] / ibl::pi_v<double> : dvec3(0.0);
-            const double yr = ibl::luminance(shader.ambient(nv, sr));
-            spec.add(ibl::luminance(lo_plan) - yr, yr);
-            ibl::ibl_sample<double> s1 = sr;
-            s1.ld = conv_ld(rough, i, ms.m.roughness);
-            noise.add(ibl::luminance(shader.ambient(nv, s1)) - yr, yr);
-            // informational: the whole ambient term (the planned diffuse product included) vs the
-            // converged set, --compare-full's "planned vs converged"
-            dvec3 lo_all = shader.ambient(nv, planned_full.split_sum().sample(n, v, ms.m.roughness));
-            if (ctx.sun) lo_all += ibl::shade_disk(n, v, *ctx.sun, shader.m);
-            combined.add(ibl::luminance(lo_all) - yr, yr);
-        }
-    }
-    points_ = spec.n;
-    combined_ = combined.value();
-    target_row ts{"specular", ctx.plan.error_target, spec.value(), 2.0 * noise.value(), spec.se(), true,
+    const std::vector<char> read = levels_read(ctx.plan.specular, mats, planned_full.specular);
+    for (char r : read) directions_ += r ? dirs.size() : 0;
+    const converged_chain cc = converge_levels(ctx, read, dirs, planned_full.specular);
+    const ambient_errors a = measure_ambient(ctx, planned_full, cc, pts, mats, e);
+    points_ = a.spec.n;
+    combined_ = a.combined.value();
+    target_row ts{"specular", ctx.plan.error_target, a.spec.value(), 2.0 * a.noise.value(), a.spec.se(), true,
                   "relative RMS of ambient luminance, planned chain + DFG table vs converged (4096 spp, dfg_exact), "
                   "brute-force irradiance in both"};
     ts.met = ts.measured <= ts.target;
     targets_.push_back(ts);
-    if (diffuse_lit) {
-        rel_rms dif;
-        for (std::size_t i = 0; i < normals.size(); ++i) {
-            const dvec3 ep = planned_full.irradiance(normals[i]);
-            const double er = e_whole[i].x + e_whole[i].y + e_whole[i].z;
-            dif.add(ep.x + ep.y + ep.z - er, er);
-        }
-        target_row td{"diffuse", ctx.plan.diffuse_error_target, dif.value(), 0.0, dif.se(), true,
-                      "RMS(E_product - E) / RMS(E) (RGB sums) over the normals, E by brute force over the source"};
-        td.met = td.measured <= td.target;
-        targets_.push_back(td);
-    }
+    if (ctx.plan.diffuse.kind != ibl::diffuse_product::none) targets_.push_back(diffuse_target(ctx, planned_full, normals, e.whole));
     for (const auto& t : targets_)
         if (!t.met)
             ctx.target_misses.push_back("scene target missed: " + t.name + fmt(" error %.3g", t.measured) + fmt(" > target %.3g", t.target) +
