@@ -209,25 +209,29 @@ struct option_spec {
     handler apply;
 };
 
-const std::map<std::string, option_spec>& option_table() {
-    static const std::map<std::string, option_spec> t = {
-        {"--help", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
-        {"-h", {false, [](bake_options& o, const std::string&) { o.help = true; }}},
-        {"--version", {false, [](bake_options& o, const std::string&) { o.version = true; }}},
-        {"--quiet", {false, [](bake_options& o, const std::string&) { o.quiet = true; }}},
-        {"--preset", {true, [](bake_options& o, const std::string& v) { apply_preset(o, choice("--preset", v, {bake_preset::standard, bake_preset::accurate, bake_preset::filament, bake_preset::gltf})); }}},
-        {"--policy", {true, [](bake_options& o, const std::string& v) { o.policy = choice("--policy", v, {ibl::roughness_mip_policy::linear(), ibl::roughness_mip_policy::filament()}); }}},
-        {"--mirror", {false, [](bake_options& o, const std::string&) { o.mirror = true; }}},
-        {"--sheen", {false, [](bake_options& o, const std::string&) { o.sheen = true; }}},
-        {"--compare-full", {false, [](bake_options& o, const std::string&) { o.compare_full = true; }}},
-        {"--strict", {false, [](bake_options& o, const std::string&) { o.strict = true; }}},
-        {"--checks", {true, [](bake_options& o, const std::string& v) { o.checks = choice("--checks", v, {check_mode::fast, check_mode::full, check_mode::none}); }}},
-        {"--verbose", {false, [](bake_options& o, const std::string&) { o.verbose = true; }}},
-        {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
-        {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
-        {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
-        {"--sh-bands", {true, [](bake_options& o, const std::string& v) { o.sh_bands = int(parse_integer("--sh-bands", v, 2, 5)); }}},
-        {"--sh-window", {true, [](bake_options& o, const std::string& v) { o.sh_window = sh_window_from("--sh-window", v); }}},
+using option_map = std::map<std::string, option_spec>;
+
+/// The switches (no value).
+option_map switch_options() {
+    const auto on = [](bool bake_options::*field) {
+        return option_spec{false, [field](bake_options& o, const std::string&) { o.*field = true; }};
+    };
+    return {{"--help", on(&bake_options::help)},         {"-h", on(&bake_options::help)},
+            {"--version", on(&bake_options::version)},   {"--quiet", on(&bake_options::quiet)},
+            {"--mirror", on(&bake_options::mirror)},     {"--sheen", on(&bake_options::sheen)},
+            {"--compare-full", on(&bake_options::compare_full)}, {"--strict", on(&bake_options::strict)},
+            {"--verbose", on(&bake_options::verbose)}};
+}
+
+/// The conventions of the products: what --preset sets, each also on its own.
+option_map convention_options() {
+    return {
+        {"--preset", {true, [](bake_options& o, const std::string& v) {
+             apply_preset(o, choice("--preset", v, {bake_preset::standard, bake_preset::accurate, bake_preset::filament, bake_preset::gltf}));
+         }}},
+        {"--policy", {true, [](bake_options& o, const std::string& v) {
+             o.policy = choice("--policy", v, {ibl::roughness_mip_policy::linear(), ibl::roughness_mip_policy::filament()});
+         }}},
         {"--irradiance-size", {true, [](bake_options& o, const std::string& v) {
              o.irradiance_size = int(parse_integer("--irradiance-size", v, 0, 256));
          }}},
@@ -242,6 +246,15 @@ const std::map<std::string, option_spec>& option_table() {
          }}},
         {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {ibl::ld_weight::g1, ibl::ld_weight::n_dot_l}); }}},
         {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {runtime_choice::lobe, runtime_choice::taps2, runtime_choice::split_sum}); }}},
+    };
+}
+
+/// What is read and written: paths, the input's form, the files' layouts and format.
+option_map file_options() {
+    return {
+        {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
+        {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
+        {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
         {"--part", {true, [](bake_options& o, const std::string& v) {
              if (v.empty()) throw usage_error("--part: empty name");
@@ -254,15 +267,8 @@ const std::map<std::string, option_spec>& option_table() {
         {"--layout", {true, [](bake_options& o, const std::string& v) {
              o.layouts = choices("--layout", v, {level_layout::faces, level_layout::latlong, level_layout::cross, level_layout::octahedral});
          }}},
-        {"--size", {true, [](bake_options& o, const std::string& v) { o.size = int(parse_integer("--size", v, 1, 4096)); }}},
-        {"--lut-size", {true, [](bake_options& o, const std::string& v) { o.lut_size = int(parse_integer("--lut-size", v, 1, 1024)); }}},
-        {"--levels", {true, [](bake_options& o, const std::string& v) { o.levels = int(parse_integer("--levels", v, 0, 13)); }}},
-        {"--threads", {true, [](bake_options& o, const std::string& v) { o.threads = unsigned(parse_integer("--threads", v, 0, 256)); }}},
         {"--max-input-pixels", {true, [](bake_options& o, const std::string& v) {
              o.max_input_pixels = std::uint64_t(parse_integer("--max-input-pixels", v, 1, 1ll << 32));
-         }}},
-        {"--quality", {true, [](bake_options& o, const std::string& v) {
-             o.q = choice("--quality", v, {quality::low, quality::standard, quality::high});
          }}},
         {"--ktx2-format", {true, [](bake_options& o, const std::string& v) {
              const std::string f = choice("--ktx2-format", v, std::initializer_list<std::string>{"f16", "f32", "rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"});
@@ -270,6 +276,28 @@ const std::map<std::string, option_spec>& option_table() {
                                     {ktx2_storage::rgba16f, ktx2_storage::rgba32f, ktx2_storage::b10g11r11, ktx2_storage::e5b9g9r9});
          }}},
     };
+}
+
+/// The sizes, the cost and the checks.
+option_map size_options() {
+    return {
+        {"--size", {true, [](bake_options& o, const std::string& v) { o.size = int(parse_integer("--size", v, 1, 4096)); }}},
+        {"--lut-size", {true, [](bake_options& o, const std::string& v) { o.lut_size = int(parse_integer("--lut-size", v, 1, 1024)); }}},
+        {"--levels", {true, [](bake_options& o, const std::string& v) { o.levels = int(parse_integer("--levels", v, 0, 13)); }}},
+        {"--threads", {true, [](bake_options& o, const std::string& v) { o.threads = unsigned(parse_integer("--threads", v, 0, 256)); }}},
+        {"--sh-bands", {true, [](bake_options& o, const std::string& v) { o.sh_bands = int(parse_integer("--sh-bands", v, 2, 5)); }}},
+        {"--sh-window", {true, [](bake_options& o, const std::string& v) { o.sh_window = sh_window_from("--sh-window", v); }}},
+        {"--quality", {true, [](bake_options& o, const std::string& v) { o.q = choice("--quality", v, {quality::low, quality::standard, quality::high}); }}},
+        {"--checks", {true, [](bake_options& o, const std::string& v) { o.checks = choice("--checks", v, {check_mode::fast, check_mode::full, check_mode::none}); }}},
+    };
+}
+
+const option_map& option_table() {
+    static const option_map t = [] {
+        option_map m = switch_options();
+        for (option_map part : {convention_options(), file_options(), size_options()}) m.merge(part);
+        return m;
+    }();
     return t;
 }
 
