@@ -350,34 +350,39 @@ void put_key_values(std::vector<unsigned char>& b, std::size_t at_kv, const std:
     }
 }
 
-} // namespace
+/// Where the parts of a KTX2 file lie: the DFD, the key/value data, each level's texels (the
+/// smallest level first in the file), and the file's size.
+struct ktx2_placement {
+    std::uint32_t dfd_total = 0;
+    std::size_t dfd_offset = 0, kvd_offset = 0, kvd_length = 0, size = 0;
+    std::vector<std::size_t> offset, length;
+};
 
-std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
-                                               const std::string& name, ktx2_clamp_counts* counts,
-                                               const std::vector<std::pair<std::string, std::string>>& metadata) {
-    check_cube(cube, name);
-    if (!known_format(std::uint32_t(format)))
-        throw image_error(name, "unsupported KTX2 format " + std::to_string(std::uint32_t(format)));
-    const std::uint32_t dfd_total = dfd_total_bytes(format);
+ktx2_placement place_ktx2(const cubemap_rgb32f& cube, ktx2_format format, std::size_t kvd_length) {
+    ktx2_placement p;
     const std::size_t L = cube.levels.size();
     const std::size_t tb = texel_bytes(format);
-    const std::size_t dfd_offset = header_bytes + level_entry_bytes * L;
-    const std::size_t kvd_offset = dfd_offset + dfd_total;
-    std::size_t kvd_length = 0;
-    const std::vector<std::pair<std::string, std::string>> kv = ktx2_key_values(writer, name, metadata, kvd_length);
-    std::size_t pos = kvd_offset + kvd_length;
-
-    // Level placement, smallest level first.
-    std::vector<std::size_t> offset(L), length(L);
+    p.dfd_total = dfd_total_bytes(format);
+    p.dfd_offset = header_bytes + level_entry_bytes * L;
+    p.kvd_offset = p.dfd_offset + p.dfd_total;
+    p.kvd_length = kvd_length;
+    std::size_t pos = p.kvd_offset + kvd_length;
+    p.offset.resize(L);
+    p.length.resize(L);
     for (std::size_t i = L; i-- > 0;) {
         const std::size_t s = std::size_t(cube.face_size(int(i)));
         pos = align_up(pos, tb); // lcm(texel size, 4) = texel size for 4, 8 and 16
-        offset[i] = pos;
-        length[i] = 6 * s * s * tb;
-        pos += length[i];
+        p.offset[i] = pos;
+        p.length[i] = 6 * s * s * tb;
+        pos += p.length[i];
     }
-    std::vector<unsigned char> b(pos, 0);
+    p.size = pos;
+    return p;
+}
 
+/// The identifier, the header and the level index.
+void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p) {
+    const std::size_t L = cube.levels.size();
     std::memcpy(b.data(), ktx2_identifier, sizeof ktx2_identifier);
     put32(b, 12, std::uint32_t(format));
     put32(b, 16, format == ktx2_format::rgba16f ? 2 : 4);
@@ -388,28 +393,27 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
     put32(b, 36, 6); // faceCount
     put32(b, 40, std::uint32_t(L));
     put32(b, 44, 0); // supercompressionScheme
-    put32(b, 48, std::uint32_t(dfd_offset));
-    put32(b, 52, dfd_total);
-    put32(b, 56, std::uint32_t(kvd_offset));
-    put32(b, 60, std::uint32_t(kvd_length));
+    put32(b, 48, std::uint32_t(p.dfd_offset));
+    put32(b, 52, p.dfd_total);
+    put32(b, 56, std::uint32_t(p.kvd_offset));
+    put32(b, 60, std::uint32_t(p.kvd_length));
     put64(b, 64, 0); // sgdByteOffset
     put64(b, 72, 0); // sgdByteLength
     for (std::size_t l = 0; l < L; ++l) {
         const std::size_t at = header_bytes + level_entry_bytes * l;
-        put64(b, at, offset[l]);
-        put64(b, at + 8, length[l]);
-        put64(b, at + 16, length[l]);
+        put64(b, at, p.offset[l]);
+        put64(b, at + 8, p.length[l]);
+        put64(b, at + 16, p.length[l]);
     }
+}
 
-    put_dfd(b, dfd_offset, format, dfd_total, tb);
-
-    put_key_values(b, kvd_offset, kv);
-
-    // Texels.
+/// Every level's texels in `format`; what the format clamped.
+ktx2_clamp_counts put_ktx2_texels(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p) {
+    const std::size_t tb = texel_bytes(format);
     ktx2_clamp_counts seen;
-    for (std::size_t l = 0; l < L; ++l) {
+    for (std::size_t l = 0; l < cube.levels.size(); ++l) {
         const std::size_t s = std::size_t(cube.face_size(int(l)));
-        std::size_t at = offset[l];
+        std::size_t at = p.offset[l];
         for (std::size_t f = 0; f < 6; ++f) {
             const std::vector<float>& src = cube.levels[l][f];
             for (std::size_t t = 0; t < s * s; ++t) {
@@ -420,6 +424,25 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
             }
         }
     }
+    return seen;
+}
+
+} // namespace
+
+std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
+                                               const std::string& name, ktx2_clamp_counts* counts,
+                                               const std::vector<std::pair<std::string, std::string>>& metadata) {
+    check_cube(cube, name);
+    if (!known_format(std::uint32_t(format)))
+        throw image_error(name, "unsupported KTX2 format " + std::to_string(std::uint32_t(format)));
+    std::size_t kvd_length = 0;
+    const std::vector<std::pair<std::string, std::string>> kv = ktx2_key_values(writer, name, metadata, kvd_length);
+    const ktx2_placement p = place_ktx2(cube, format, kvd_length);
+    std::vector<unsigned char> b(p.size, 0);
+    put_ktx2_header(b, cube, format, p);
+    put_dfd(b, p.dfd_offset, format, p.dfd_total, texel_bytes(format));
+    put_key_values(b, p.kvd_offset, kv);
+    const ktx2_clamp_counts seen = put_ktx2_texels(b, cube, format, p);
     if (counts) *counts = seen;
     return b;
 }
