@@ -348,65 +348,71 @@ std::string output_stage::file(const std::string& name) {
     return (fs::path(staging_) / name).string();
 }
 
+void output_stage::carry_existing(unsigned mode) {
+    const fs::path target(dir_), stage(staging_);
+    for (const std::string& n : names_) {
+        struct stat e {};
+        if (::lstat((target / n).c_str(), &e) == 0 && !S_ISREG(e.st_mode))
+            throw std::runtime_error((target / n).string() + ": is not a regular file, and ibl-bake writes a file of that name; "
+                                                             "move it away (the output directory was left as it was)");
+    }
+    std::error_code ec;
+    std::vector<fs::path> keep;
+    for (const auto& entry : fs::directory_iterator(target, ec)) {
+        const std::string n = entry.path().filename().string();
+        if (std::find(names_.begin(), names_.end(), n) != names_.end()) continue; // replaced
+        if (is_level_face(n) && entry.is_regular_file(ec)) continue;               // stale level: dropped
+        keep.push_back(entry.path());
+    }
+    if (ec) throw std::runtime_error(dir_ + ": cannot list the output directory: " + ec.message());
+    for (const fs::path& k : keep) carry(k, stage / k.filename(), 0);
+    ::chmod(staging_.c_str(), mode & 07777);
+}
+
+std::string output_stage::swap_in(bool exists) {
+    std::string old;
+    const signal_block block;
+    int s = 1;
+    if (!g_state.compare_exchange_strong(s, 3)) wait_for_signal_death();
+    int err = 0;
+    if (!exists) {
+        if (std::rename(staging_.c_str(), dir_.c_str()) != 0) err = errno;
+    } else if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, dir_.c_str(), RENAME_EXCHANGE) == 0) {
+        old = staging_; // g_path already names it
+    } else if (errno == EINVAL || errno == ENOSYS || errno == EOPNOTSUPP) {
+        const std::string aside = staging_ + ".old";
+        if (std::rename(dir_.c_str(), aside.c_str()) != 0) err = errno;
+        else if (std::rename(staging_.c_str(), dir_.c_str()) != 0) {
+            err = errno;
+            std::rename(aside.c_str(), dir_.c_str());
+        } else {
+            old = aside;
+            std::memcpy(g_path, aside.c_str(), std::min(aside.size() + 1, path_capacity - 1));
+            g_path[path_capacity - 1] = '\0';
+        }
+    } else {
+        err = errno;
+    }
+    if (err != 0) {
+        g_state.store(1);
+        throw std::runtime_error(dir_ + ": cannot move the new output directory into place: " + errno_text(err) +
+                                 " (the output directory was left as it was)");
+    }
+    committed_ = true;
+    g_state.store(old.empty() ? 0 : 4);
+    return old;
+}
+
 void output_stage::commit() {
     if (committed_) return;
-    const fs::path target(dir_), stage(staging_);
     struct stat st {};
     const bool exists = ::lstat(dir_.c_str(), &st) == 0;
     if (exists) {
         if (!S_ISDIR(st.st_mode)) throw std::runtime_error(dir_ + ": exists and is not a directory");
-        for (const std::string& n : names_) {
-            struct stat e {};
-            if (::lstat((target / n).c_str(), &e) == 0 && !S_ISREG(e.st_mode))
-                throw std::runtime_error((target / n).string() + ": is not a regular file, and ibl-bake writes a file of that name; "
-                                                                 "move it away (the output directory was left as it was)");
-        }
-        std::error_code ec;
-        std::vector<fs::path> keep;
-        for (const auto& entry : fs::directory_iterator(target, ec)) {
-            const std::string n = entry.path().filename().string();
-            if (std::find(names_.begin(), names_.end(), n) != names_.end()) continue; // replaced
-            if (is_level_face(n) && entry.is_regular_file(ec)) continue;               // stale level: dropped
-            keep.push_back(entry.path());
-        }
-        if (ec) throw std::runtime_error(dir_ + ": cannot list the output directory: " + ec.message());
-        for (const fs::path& k : keep) carry(k, stage / k.filename(), 0);
-        ::chmod(staging_.c_str(), st.st_mode & 07777);
+        carry_existing(st.st_mode);
     }
-    fsync_dir(stage);
-
-    std::string old; // the path that holds the old DIR after the swap
-    {
-        const signal_block block;
-        int s = 1;
-        if (!g_state.compare_exchange_strong(s, 3)) wait_for_signal_death();
-        int err = 0;
-        if (!exists) {
-            if (std::rename(staging_.c_str(), dir_.c_str()) != 0) err = errno;
-        } else if (::renameat2(AT_FDCWD, staging_.c_str(), AT_FDCWD, dir_.c_str(), RENAME_EXCHANGE) == 0) {
-            old = staging_; // g_path already names it
-        } else if (errno == EINVAL || errno == ENOSYS || errno == EOPNOTSUPP) {
-            const std::string aside = staging_ + ".old";
-            if (std::rename(dir_.c_str(), aside.c_str()) != 0) err = errno;
-            else if (std::rename(staging_.c_str(), dir_.c_str()) != 0) {
-                err = errno;
-                std::rename(aside.c_str(), dir_.c_str());
-            } else {
-                old = aside;
-                std::memcpy(g_path, aside.c_str(), std::min(aside.size() + 1, path_capacity - 1));
-                g_path[path_capacity - 1] = '\0';
-            }
-        } else {
-            err = errno;
-        }
-        if (err != 0) {
-            g_state.store(1);
-            throw std::runtime_error(dir_ + ": cannot move the new output directory into place: " + errno_text(err) +
-                                     " (the output directory was left as it was)");
-        }
-        committed_ = true;
-        g_state.store(old.empty() ? 0 : 4);
-    }
+    fsync_dir(fs::path(staging_));
+    const std::string old = swap_in(exists); // the path that holds the old DIR after the swap
     if (!old.empty()) {
         int s = 4;
         if (g_state.compare_exchange_strong(s, 0)) {
@@ -414,7 +420,7 @@ void output_stage::commit() {
             fs::remove_all(old, ec); // if this fails, the next run removes it (stale, pid gone)
         }
     }
-    fsync_dir(target.parent_path());
+    fsync_dir(fs::path(dir_).parent_path());
 }
 
 } // namespace ibl_bake

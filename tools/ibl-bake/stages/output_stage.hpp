@@ -77,6 +77,13 @@ public:
     void commit();
 
 private:
+    /// Into the stage, what an existing DIR holds beside the files of this bake (a stale level's
+    /// faces aside); refuses a non-file where a file of this bake goes. `mode`: DIR's permissions.
+    void carry_existing(unsigned mode);
+    /// Swaps the stage in as DIR (a rename when there is none), signals blocked; the path that
+    /// holds the old DIR (empty when there was none).
+    std::string swap_in(bool exists);
+
     std::string dir_, staging_;
     std::vector<std::string> names_;
     int lock_fd_ = -1;
