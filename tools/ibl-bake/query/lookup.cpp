@@ -102,74 +102,93 @@ dvec3 unit(double x, double y, double z, const char* what) {
 
 double unit_interval(double x) { return std::clamp(x, 0.0, 1.0); }
 
+// The answers, one function per query word: the numbers a (their count checked) against the bake.
+using numbers_t = std::vector<double>;
+
+std::string answer_specular(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (!b.has_chain) throw std::invalid_argument("the bake has no specular chain");
+    const dvec3 d = unit(a[0], a[1], a[2], "the direction");
+    return triple(v.ld(d, unit_interval(a[3])) + sun_ld(v.sun, d, unit_interval(a[3]), v.weight));
+}
+
+std::string answer_dfg(const baked_folder& b, const product_view&, const numbers_t& a) {
+    if (!b.has_lut) throw std::invalid_argument("the bake has no DFG table");
+    const fvec3 ab = ibl::dfg_lookup(b.lut, float(unit_interval(a[0])), float(unit_interval(a[1])));
+    return fmt9(ab.x) + " " + fmt9(ab.y);
+}
+
+std::string answer_irradiance(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (b.diffuse.kind == ibl::diffuse_product::none) throw std::invalid_argument("the bake has no diffuse product");
+    return triple(v.irradiance(unit(a[0], a[1], a[2], "the normal")));
+}
+
+std::string answer_shade(const baked_folder&, const product_view& v, const numbers_t& a) {
+    const dvec3 n = unit(a[0], a[1], a[2], "the normal"), vv = unit(a[3], a[4], a[5], "the view direction");
+    ibl::pbr_material<double> m;
+    m.roughness = unit_interval(a[6]);
+    m.metallic = unit_interval(a[7]);
+    m.base_color = glm::clamp(dvec3(a[8], a[9], a[10]), dvec3(0.0), dvec3(1.0));
+    const auto shader = ibl::pbr_shader<double>::from(m, true);
+    return triple(v.shade(shader, n, vv));
+}
+
+std::string answer_sheen(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen chain (bake with --sheen)");
+    const dvec3 d = unit(a[0], a[1], a[2], "the direction");
+    const float lod = ibl::roughness_mip_policy::linear().lod(float(unit_interval(a[3])), b.sheen.levels());
+    return triple(dvec3(b.sheen.radiance(fvec3(d), lod)) + sheen_sun_ld(v.sun, d, unit_interval(a[3])));
+}
+
+std::string answer_dfg_sheen(const baked_folder& b, const product_view&, const numbers_t& a) {
+    if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen table (bake with --sheen)");
+    return fmt9(b.sheen_lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1]))).x);
+}
+
+std::string answer_lobe(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (!b.has_lobe) throw std::invalid_argument("the bake has no lobe LUT (bake with --runtime lobe)");
+    const ibl::vec4<double> p = v.lobe_params(unit_interval(a[0]), unit_interval(a[1]));
+    return fmt9(p.x) + " " + fmt9(p.y) + " " + fmt9(p.z) + " " + fmt9(p.w);
+}
+
+std::string answer_lobe_b(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (!b.has_lobe_b) throw std::invalid_argument("the bake has no B-part lobe table (bake with --runtime lobe)");
+    const ibl::vec2<double> p = v.lobe_b_params(unit_interval(a[0]), unit_interval(a[1]));
+    return fmt9(p.x) + " " + fmt9(p.y);
+}
+
+std::string answer_taps(const baked_folder& b, const product_view& v, const numbers_t& a) {
+    if (!b.has_taps) throw std::invalid_argument("the bake has no two-tap table (bake with --runtime taps2)");
+    std::string s;
+    for (const float x : v.taps_params(unit_interval(a[0]), unit_interval(a[1]))) {
+        if (!s.empty()) s += ' ';
+        s += fmt9(x);
+    }
+    return s;
+}
+
+struct query_kind {
+    const char* word;
+    std::size_t count; ///< of numbers
+    std::string (*answer)(const baked_folder&, const product_view&, const numbers_t&);
+};
+
+constexpr query_kind query_kinds[] = {
+    {"specular", 4, answer_specular}, {"dfg", 2, answer_dfg},           {"irradiance", 3, answer_irradiance},
+    {"shade", 11, answer_shade},      {"sheen", 4, answer_sheen},       {"dfg_sheen", 2, answer_dfg_sheen},
+    {"lobe", 2, answer_lobe},         {"lobe_b", 2, answer_lobe_b},     {"taps", 2, answer_taps},
+};
+
 /// One answer line for a query, or throws std::invalid_argument with the reason.
-std::string answer(const baked_folder& b, const product_view& v, const std::string& word, const std::vector<double>& a) {
-    auto need = [&](std::size_t n) {
-        if (a.size() != n)
-            throw std::invalid_argument("'" + word + "' takes " + std::to_string(n) + " numbers, got " + std::to_string(a.size()));
-    };
-    if (word == "specular") {
-        need(4);
-        if (!b.has_chain) throw std::invalid_argument("the bake has no specular chain");
-        const dvec3 d = unit(a[0], a[1], a[2], "the direction");
-        return triple(v.ld(d, unit_interval(a[3])) + sun_ld(v.sun, d, unit_interval(a[3]), v.weight));
+std::string answer(const baked_folder& b, const product_view& v, const std::string& word, const numbers_t& a) {
+    std::string words;
+    for (const query_kind& q : query_kinds) {
+        words += (words.empty() ? "" : ", ") + std::string(q.word);
+        if (word != q.word) continue;
+        if (a.size() != q.count)
+            throw std::invalid_argument("'" + word + "' takes " + std::to_string(q.count) + " numbers, got " + std::to_string(a.size()));
+        return q.answer(b, v, a);
     }
-    if (word == "dfg") {
-        need(2);
-        if (!b.has_lut) throw std::invalid_argument("the bake has no DFG table");
-        const fvec3 ab = ibl::dfg_lookup(b.lut, float(unit_interval(a[0])), float(unit_interval(a[1])));
-        return fmt9(ab.x) + " " + fmt9(ab.y);
-    }
-    if (word == "irradiance") {
-        need(3);
-        if (b.diffuse.kind == ibl::diffuse_product::none) throw std::invalid_argument("the bake has no diffuse product");
-        return triple(v.irradiance(unit(a[0], a[1], a[2], "the normal")));
-    }
-    if (word == "shade") {
-        need(11);
-        const dvec3 n = unit(a[0], a[1], a[2], "the normal"), vv = unit(a[3], a[4], a[5], "the view direction");
-        ibl::pbr_material<double> m;
-        m.roughness = unit_interval(a[6]);
-        m.metallic = unit_interval(a[7]);
-        m.base_color = glm::clamp(dvec3(a[8], a[9], a[10]), dvec3(0.0), dvec3(1.0));
-        const auto shader = ibl::pbr_shader<double>::from(m, true);
-        return triple(v.shade(shader, n, vv));
-    }
-    if (word == "sheen") {
-        need(4);
-        if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen chain (bake with --sheen)");
-        const dvec3 d = unit(a[0], a[1], a[2], "the direction");
-        const float lod = ibl::roughness_mip_policy::linear().lod(float(unit_interval(a[3])), b.sheen.levels());
-        return triple(dvec3(b.sheen.radiance(fvec3(d), lod)) + sheen_sun_ld(v.sun, d, unit_interval(a[3])));
-    }
-    if (word == "dfg_sheen") {
-        need(2);
-        if (!b.has_sheen) throw std::invalid_argument("the bake has no sheen table (bake with --sheen)");
-        return fmt9(b.sheen_lut.sample(float(unit_interval(a[0])), float(unit_interval(a[1]))).x);
-    }
-    if (word == "lobe") {
-        need(2);
-        if (!b.has_lobe) throw std::invalid_argument("the bake has no lobe LUT (bake with --runtime lobe)");
-        const ibl::vec4<double> p = v.lobe_params(unit_interval(a[0]), unit_interval(a[1]));
-        return fmt9(p.x) + " " + fmt9(p.y) + " " + fmt9(p.z) + " " + fmt9(p.w);
-    }
-    if (word == "lobe_b") {
-        need(2);
-        if (!b.has_lobe_b) throw std::invalid_argument("the bake has no B-part lobe table (bake with --runtime lobe)");
-        const ibl::vec2<double> p = v.lobe_b_params(unit_interval(a[0]), unit_interval(a[1]));
-        return fmt9(p.x) + " " + fmt9(p.y);
-    }
-    if (word == "taps") {
-        need(2);
-        if (!b.has_taps) throw std::invalid_argument("the bake has no two-tap table (bake with --runtime taps2)");
-        std::string s;
-        for (const float x : v.taps_params(unit_interval(a[0]), unit_interval(a[1]))) {
-            if (!s.empty()) s += ' ';
-            s += fmt9(x);
-        }
-        return s;
-    }
-    throw std::invalid_argument("unknown query '" + word + "' (specular, dfg, irradiance, shade, sheen, dfg_sheen, lobe, lobe_b, taps)");
+    throw std::invalid_argument("unknown query '" + word + "' (" + words + ")");
 }
 
 } // namespace
