@@ -279,22 +279,18 @@ void scan_exr_attribute(exr_reader& r, std::span<const unsigned char> b, std::st
     r.p += std::size_t(size);
 }
 
-/// Checks a part's header as a whole (required attributes, type, windows, tiles, decoded size,
-/// chunk count); throws image_error.
-void check_exr_part(exr_part_scan& P, std::size_t index, bool multipart, std::uint32_t flags, const std::string& file,
-                    const read_options& o) {
-    const std::string label = exr_part_label(P, index);
-    const auto bad = [&](const std::string& what) -> image_error {
-        return image_error(file, "corrupt OpenEXR header (" + label + ": " + what + ")");
-    };
-    if (!P.has_channels) throw bad("no channels attribute");
-    if (P.compression < 0) throw bad("no compression attribute");
-    if (!P.has_data || !P.has_display) throw bad("no data or display window");
+image_error exr_header_error(const std::string& file, const std::string& label, const std::string& what) {
+    return image_error(file, "corrupt OpenEXR header (" + label + ": " + what + ")");
+}
+
+/// Sets P.tiled and P.deep from the part's type (multi-part files) or the version's tiled flag
+/// (single-part files, whose type attribute must agree); throws image_error.
+void resolve_exr_layout(exr_part_scan& P, bool multipart, std::uint32_t flags, const std::string& file, const std::string& label) {
     if (multipart) {
         // Every part of a multi-part file names its type; the version's tiled flag is unused.
-        if (!P.has_type) throw bad("no type attribute");
-        if (!P.has_name) throw bad("no name attribute");
-        if (!P.has_chunk_count) throw bad("no chunkCount attribute");
+        if (!P.has_type) throw exr_header_error(file, label, "no type attribute");
+        if (!P.has_name) throw exr_header_error(file, label, "no name attribute");
+        if (!P.has_chunk_count) throw exr_header_error(file, label, "no chunkCount attribute");
         if (P.type == "scanlineimage" || P.type == "tiledimage") {
             P.tiled = P.type == "tiledimage";
         } else if (P.type == "deepscanline" || P.type == "deeptile") {
@@ -311,6 +307,10 @@ void check_exr_part(exr_part_scan& P, std::size_t index, bool multipart, std::ui
             throw image_error(file, "OpenEXR type attribute '" + printable(P.type) + "' contradicts the file's " +
                                         (P.tiled ? "tiled" : "scanline") + " layout (expected '" + expected + "')");
     }
+}
+
+/// The windows, the tiles and the decoded sizes against the limits of `o`; throws image_error.
+void check_exr_sizes(const exr_part_scan& P, const std::string& file, const std::string& label, const read_options& o) {
     const auto dims = [](const exr_box& x, std::int64_t& w, std::int64_t& h) {
         w = std::clamp<std::int64_t>(x.width(), -1, INT_MAX);
         h = std::clamp<std::int64_t>(x.height(), -1, INT_MAX);
@@ -321,28 +321,39 @@ void check_exr_part(exr_part_scan& P, std::size_t index, bool multipart, std::ui
     dims(P.data, w, h);
     check_dimensions(int(w), int(h), o, file, ("OpenEXR data window of " + label).c_str());
     if (P.tiled) {
-        if (!P.has_tiles) throw bad("tiled, but no tiles attribute");
+        if (!P.has_tiles) throw exr_header_error(file, label, "tiled, but no tiles attribute");
         if (P.tile_x < 1 || P.tile_y < 1 || P.tile_x > std::uint32_t(o.max_dimension) ||
             P.tile_y > std::uint32_t(o.max_dimension))
-            throw bad("tile size " + std::to_string(P.tile_x) + " x " + std::to_string(P.tile_y) +
-                      " outside [1, " + std::to_string(o.max_dimension) + "]");
+            throw exr_header_error(file, label, "tile size " + std::to_string(P.tile_x) + " x " + std::to_string(P.tile_y) +
+                                                    " outside [1, " + std::to_string(o.max_dimension) + "]");
     }
-    if (!P.deep) {
-        // OpenEXR allocates the decoded pixels of a chunk (a block of scanlines or a tile) up
-        // front, and the reader the whole data window: both must fit max_decoded_bytes.
-        const std::uint64_t chunk_pixels =
-            P.tiled ? std::uint64_t(P.tile_x) * P.tile_y : std::uint64_t(w) * std::uint64_t(exr_lines_per_chunk[P.compression]);
-        const std::uint64_t limit = o.max_decoded_bytes;
-        for (const std::uint64_t pixels : {std::uint64_t(w) * std::uint64_t(h), chunk_pixels})
-            if (P.bytes_per_pixel > limit || pixels > limit / P.bytes_per_pixel)
-                throw image_error(file, "OpenEXR " + label + ": " + std::to_string(pixels) + " pixels of " +
-                                            std::to_string(P.bytes_per_pixel) +
-                                            " bytes exceed the decoding limit of " + std::to_string(limit) + " bytes");
-    }
+    if (P.deep) return;
+    // OpenEXR allocates the decoded pixels of a chunk (a block of scanlines or a tile) up front,
+    // and the reader the whole data window: both must fit max_decoded_bytes.
+    const std::uint64_t chunk_pixels =
+        P.tiled ? std::uint64_t(P.tile_x) * P.tile_y : std::uint64_t(w) * std::uint64_t(exr_lines_per_chunk[P.compression]);
+    const std::uint64_t limit = o.max_decoded_bytes;
+    for (const std::uint64_t pixels : {std::uint64_t(w) * std::uint64_t(h), chunk_pixels})
+        if (P.bytes_per_pixel > limit || pixels > limit / P.bytes_per_pixel)
+            throw image_error(file, "OpenEXR " + label + ": " + std::to_string(pixels) + " pixels of " +
+                                        std::to_string(P.bytes_per_pixel) + " bytes exceed the decoding limit of " +
+                                        std::to_string(limit) + " bytes");
+}
+
+/// Checks a part's header as a whole (required attributes, type, windows, tiles, decoded size,
+/// chunk count); throws image_error.
+void check_exr_part(exr_part_scan& P, std::size_t index, bool multipart, std::uint32_t flags, const std::string& file,
+                    const read_options& o) {
+    const std::string label = exr_part_label(P, index);
+    if (!P.has_channels) throw exr_header_error(file, label, "no channels attribute");
+    if (P.compression < 0) throw exr_header_error(file, label, "no compression attribute");
+    if (!P.has_data || !P.has_display) throw exr_header_error(file, label, "no data or display window");
+    resolve_exr_layout(P, multipart, flags, file, label);
+    check_exr_sizes(P, file, label, o);
     const std::uint64_t chunks = exr_chunk_count(P);
     if (P.has_chunk_count && (P.chunk_count < 0 || std::uint64_t(P.chunk_count) != chunks))
-        throw bad("chunkCount " + std::to_string(P.chunk_count) + ", but the layout has " + std::to_string(chunks) +
-                  " chunks");
+        throw exr_header_error(file, label, "chunkCount " + std::to_string(P.chunk_count) + ", but the layout has " +
+                                                std::to_string(chunks) + " chunks");
     P.chunk_count = std::int64_t(chunks);
 }
 
