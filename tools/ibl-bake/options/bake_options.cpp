@@ -5,6 +5,7 @@
 #include <ibl/bake/prefilter.hpp>
 
 #include <algorithm>
+#include <array>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -39,63 +40,17 @@ int auto_levels(int size) { return ibl::prefilter_auto_levels(size); }
 
 const char* to_string(quality q) noexcept { return settings_for(q).name; }
 
-const char* to_string(bake_preset p) noexcept {
-    switch (p) {
-    case bake_preset::accurate: return "accurate";
-    case bake_preset::filament: return "filament";
-    case bake_preset::gltf: return "gltf";
-    case bake_preset::standard: break;
-    }
-    return "default";
-}
-
-const char* to_string(check_mode c) noexcept {
-    return c == check_mode::full ? "full" : c == check_mode::none ? "none" : "fast";
-}
-
-const char* to_string(sun_extraction s) noexcept {
-    return s == sun_extraction::automatic ? "auto" : s == sun_extraction::on ? "on" : "off";
-}
-
-const char* to_string(dfg_channel_order c) noexcept { return c == dfg_channel_order::filament ? "filament" : "ab"; }
-
-const char* to_string(runtime_choice r) noexcept {
-    return r == runtime_choice::lobe ? "lobe" : r == runtime_choice::taps2 ? "taps2" : "split-sum";
-}
-
-const char* to_string(level_layout l) noexcept {
-    switch (l) {
-    case level_layout::latlong: return "latlong";
-    case level_layout::cross: return "cross";
-    case level_layout::octahedral: return "octahedral";
-    case level_layout::faces: break;
-    }
-    return "faces";
-}
-
+// The names of each enum's values, in the order of its declaration.
+const char* to_string(bake_preset p) noexcept { return std::array{"default", "accurate", "filament", "gltf"}[std::size_t(p)]; }
+const char* to_string(check_mode c) noexcept { return std::array{"fast", "full", "none"}[std::size_t(c)]; }
+const char* to_string(sun_extraction s) noexcept { return std::array{"off", "auto", "on"}[std::size_t(s)]; }
+const char* to_string(dfg_channel_order c) noexcept { return std::array{"ab", "filament"}[std::size_t(c)]; }
+const char* to_string(runtime_choice r) noexcept { return std::array{"split-sum", "lobe", "taps2"}[std::size_t(r)]; }
+const char* to_string(level_layout l) noexcept { return std::array{"faces", "latlong", "cross", "octahedral"}[std::size_t(l)]; }
 const char* to_string(input_form f) noexcept {
-    switch (f) {
-    case input_form::latlong: return "latlong";
-    case input_form::hcross: return "hcross";
-    case input_form::vcross: return "vcross";
-    case input_form::hstrip: return "hstrip";
-    case input_form::vstrip: return "vstrip";
-    case input_form::faces: return "faces";
-    case input_form::ktx2: return "ktx2";
-    case input_form::automatic: break;
-    }
-    return "auto";
+    return std::array{"auto", "latlong", "hcross", "vcross", "hstrip", "vstrip", "faces", "ktx2"}[std::size_t(f)];
 }
-
-const char* to_string(ktx2_storage f) noexcept {
-    switch (f) {
-    case ktx2_storage::rgba32f: return "rgba32f";
-    case ktx2_storage::b10g11r11: return "b10g11r11";
-    case ktx2_storage::e5b9g9r9: return "e5b9g9r9";
-    case ktx2_storage::rgba16f: break;
-    }
-    return "rgba16f";
-}
+const char* to_string(ktx2_storage f) noexcept { return std::array{"rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"}[std::size_t(f)]; }
 
 std::string to_string(const sh_window_choice& w) {
     return w.k == sh_window_choice::kind::hanning ? w.text : w.k == sh_window_choice::kind::none ? "none" : "auto";

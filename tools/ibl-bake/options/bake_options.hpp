@@ -69,7 +69,8 @@ enum class quality { low, standard, high };
 // The option values, parsed once by parse_options: what a stage tests is one of these, never the
 // text of the command line. Where the library has the type (ibl::ld_weight, ibl::dfg_lut_layout,
 // ibl::roughness_mip_policy, ibl::specular_lookup_desc) the option holds it. to_string gives the
-// one name each value has on the command line, in report.json and in the files' metadata.
+// one name each value has on the command line, in report.json and in the files' metadata (it
+// names an enum's values by their order of declaration).
 
 /// --preset: a set of conventions (docs/ibl-bake.md, "Presets"); `standard` is named "default".
 enum class bake_preset { standard, accurate, filament, gltf };
