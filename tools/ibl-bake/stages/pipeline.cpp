@@ -1,5 +1,5 @@
 // tools/ibl-bake/stages/pipeline.cpp — runs the stages in order and assembles the files, report.json and
-// the printed table from what they return (pipeline.hpp).
+// the printed table from what they return (pipeline.hpp; the stage interface: stage.hpp).
 
 #include "stages/pipeline.hpp"
 

@@ -1,6 +1,6 @@
 #pragma once
 // tools/ibl-bake/stages/stages.hpp — the stages of the bake, in the order the pipeline runs them, and
-// what several of them share (pipeline.hpp describes the stage interface).
+// what several of them share (stage.hpp describes the stage interface).
 //
 //   plan          the full plan, or the scene's plan (--scene) and what it leaves out
 //   source        read the input (or the built-in sky); k x k supersampled bake to the source cube
@@ -34,7 +34,7 @@
 #include <ibl/runtime/shade.hpp>
 
 #include "io/ktx2.hpp"
-#include "stages/pipeline.hpp"
+#include "stages/stage.hpp"
 
 namespace ibl_bake {
 
