@@ -166,8 +166,9 @@ namespace {
 void json_runtime_model(json_writer& j, const runtime_model& rm) {
     j.key("ld_weight").begin_object();
     j.key("name").value(to_string(rm.ld_weight));
-    j.key("rule").value(rm.ld_weight == ibl::ld_weight::g1 ? "LD = int L D(h) G1(R.l) dl / int D(h) G1(R.l) dl (the specular lobe at n.v = 1)"
-                                             : "LD = int L D(h) (R.l) dl / int D(h) (R.l) dl (Karis 2013)");
+    j.key("rule").value(rm.ld_weight == ibl::ld_weight::g1
+                            ? "LD = int L D(h) G1(R.l) dl / int D(h) G1(R.l) dl (the specular lobe at n.v = 1)"
+                            : "LD = int L D(h) (R.l) dl / int D(h) (R.l) dl (Karis 2013)");
     j.end_object();
     j.key("runtime_model").begin_object();
     j.key("name").value(to_string(rm.kind));
