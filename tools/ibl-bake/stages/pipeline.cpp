@@ -78,7 +78,7 @@ void report_options(json_writer& j, const bake_context& ctx) {
     j.key("levels").value(ctx.set.levels);
     j.key("quality").value(ctx.qs.name);
     j.key("threads").value(ctx.ex.threads());
-    j.key("ktx2_format").value(o.ktx2_format == ktx2_storage::rgba32f ? "rgba32f" : "rgba16f");
+    j.key("ktx2_format").value(to_string(o.ktx2_format));
     j.key("checks").value(to_string(o.checks));
     j.end_object();
     // the sizes baked (a scene's plan may use less than --size and --lut-size); level 0 = the mirror level

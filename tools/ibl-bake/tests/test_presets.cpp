@@ -61,6 +61,11 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     // the specular section names the policy the chain was baked with
     CHECK(fil.find("specular")->find("mip_policy")->string.rfind("filament: ", 0) == 0);
     CHECK(ref.find("specular")->find("mip_policy")->string.rfind("linear: ", 0) == 0);
+    // report.json names the KTX2 storage actually written (every --ktx2-format value)
+    CHECK(ref.find("options")->find("ktx2_format")->string == "rgba16f");
+    REQUIRE(shell(tool + " --quiet --size 8 --quality low --lut-size 8 --checks none --ktx2-format e5b9g9r9 --out " +
+                  (s / "e5") + " >/dev/null") == 0);
+    CHECK(ibl_examples::parse_json(slurp(s / "e5/report.json")).find("options")->find("ktx2_format")->string == "e5b9g9r9");
     // the DFG table: filament stores (B, A + B); gltf and the reference (A, B) at texel centres
     const image_rgb32f tf = read_image(s / "fil/dfg.exr"), tr = read_image(s / "ref/dfg.exr"), tg = read_image(s / "gltf/dfg.exr");
     REQUIRE(tf.rgb.size() == tr.rgb.size());
