@@ -15,9 +15,12 @@
 #include <ibl/bake/irradiance.hpp>
 #include <ibl/reference/metrics.hpp>
 #include <ibl/bake/prefilter.hpp>
+#include <ibl/bake/prefilter_update.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
 
+#include <algorithm>
 #include <array>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -135,8 +138,38 @@ void BM_irradiance(benchmark::State& state) {
     state.counters["ratio"] = m.max_ratio;
 }
 
+/// A dynamic probe's slice: one prefilter_update::step of a budget of 2^k taps (k = range(1)) on
+/// the 256^2 source with the default options, one thread, the pass restarted when it finishes.
+/// Counters: taps per call, ns per tap, and the largest difference of the finished chain from
+/// the one-shot prefilter (0: bit for bit).
+void BM_prefilter_update_step(benchmark::State& state) {
+    const ibl::cubemap<float>& src = source(int(state.range(0)));
+    const std::uint64_t budget = std::uint64_t(1) << state.range(1);
+    ibl::prefilter_update<> up(src, ibl::prefilter_options{});
+    std::uint64_t taps = 0, calls = 0;
+    for (auto _ : state) {
+        if (up.done()) up.set_source(src);
+        taps += up.step(budget);
+        ++calls;
+    }
+    up.finish();
+    const ibl::specular_chain ref = ibl::prefilter(src, ibl::prefilter_options{}, ibl::thread_executor{2});
+    double diff = 0.0;
+    for (int l = 0; l < ref.levels(); ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < ref.size(l); ++y)
+                for (int x = 0; x < ref.size(l); ++x)
+                    for (int c = 0; c < 3; ++c)
+                        diff = std::max(diff, double(std::abs(up.result()->texel(f, x, y, l)[c] - ref.texel(f, x, y, l)[c])));
+    state.counters["taps_per_call"] = double(taps) / double(std::max<std::uint64_t>(calls, 1));
+    state.counters["ns_per_tap"] = benchmark::Counter(double(taps) * 1e-9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["max_abs_vs_oneshot"] = diff;
+    state.counters["pass_calls"] = double(up.total_taps() / budget + 1);
+}
+
 } // namespace
 
+BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget"})->ArgsProduct({{1}, {16, 20}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)
     ->ArgNames({"env", "spp"})

@@ -11,6 +11,7 @@
 #include "bake/lobe_moments.hpp"
 #include "bake/plan.hpp"
 #include "bake/prefilter.hpp"
+#include "bake/prefilter_update.hpp"
 #include "bake/sheen.hpp"
 #include "bake/specular_occlusion_lut.hpp"
 #include "bake/sphere_convolve.hpp"

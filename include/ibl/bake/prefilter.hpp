@@ -236,38 +236,55 @@ template <class Env> int prefilter_nearest_level(const Env& env, int n) {
     return std::clamp(int(std::lround(std::log2(double(env.size(0)) / double(n)))), 0, env.levels() - 1);
 }
 
-/// Level 0 of a mirror lobe: the source at the output's texel centres, read at the lod of the
-/// output texel's footprint (trilinear) or at the nearest source level (prefilter_level::trilinear).
-template <class Env, class Executor>
-std::vector<vec3<float>> prefilter_base(const Env& env, int n, bool trilinear, Executor& ex) {
+/// How level 0 of a mirror lobe reads the source: a texel-for-texel copy of source level
+/// copy_level (>= 0), or the source's radiance at the output texel centres at lod (copy_level < 0).
+struct prefilter_base_read {
+    int copy_level = -1;
+    double lod = 0.0; ///< the source's lod type (float for a float source) round-trips exactly
+};
+
+/// The read of level 0 (face size n): at the lod of the output texel's footprint (trilinear) or at
+/// the nearest source level (prefilter_level::trilinear = false), a copy where the sizes match.
+template <class Env> prefilter_base_read prefilter_base_mode(const Env& env, int n, bool trilinear) {
     using Te = std::conditional_t<environment<Env, float>, float, double>;
-    std::vector<vec3<float>> out(std::size_t(6) * std::size_t(n) * std::size_t(n));
+    Te lod = env_lod_for_solid_angle<Te>(env, Te(four_pi_v<double> / (6.0 * double(n) * double(n))));
+    if constexpr (requires { detail::pack_cube(env); }) {
+        const int sl = trilinear ? 0 : prefilter_nearest_level(env, n);
+        if (env.size(sl) == n) return {sl, 0.0}; // the same texels: an exact copy
+        if (!trilinear) lod = Te(sl);
+    } else if (!trilinear) {
+        lod = std::round(lod);
+    }
+    return {-1, double(lod)};
+}
+
+/// One face row (row = face n + y) of level 0 into out[0 .. n): non-finite components read as 0.
+template <class Env> void prefilter_base_row(const Env& env, int n, const prefilter_base_read& m, std::size_t row,
+                                             vec3<float>* out) {
+    using Te = std::conditional_t<environment<Env, float>, float, double>;
     auto finite = [](const vec3<Te>& v) {
         vec3<float> o;
         for (int k = 0; k < 3; ++k) o[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
         return o;
     };
-    Te lod = env_lod_for_solid_angle<Te>(env, Te(four_pi_v<double> / (6.0 * double(n) * double(n))));
+    const int face = int(row) / n, y = int(row) % n;
     if constexpr (requires { detail::pack_cube(env); }) {
-        const int sl = trilinear ? 0 : prefilter_nearest_level(env, n);
-        if (env.size(sl) == n) { // the same texels: an exact copy
-            for (int f = 0; f < 6; ++f)
-                for (int y = 0; y < n; ++y)
-                    for (int x = 0; x < n; ++x) out[cube_texel_index(f, x, y, n)] = finite(vec3<Te>(env.texel(f, x, y, sl)));
-            return out;
+        if (m.copy_level >= 0) {
+            for (int x = 0; x < n; ++x) out[x] = finite(vec3<Te>(env.texel(face, x, y, m.copy_level)));
+            return;
         }
-        if (!trilinear) lod = Te(sl);
-    } else if (!trilinear) {
-        lod = std::round(lod);
     }
+    for (int x = 0; x < n; ++x) out[x] = finite(vec3<Te>(env.radiance(cube_texel_direction<Te>(face, x, y, n), Te(m.lod))));
+}
+
+/// Level 0 of a mirror lobe: the source at the output's texel centres, read at the lod of the
+/// output texel's footprint (trilinear) or at the nearest source level (prefilter_level::trilinear).
+template <class Env, class Executor>
+std::vector<vec3<float>> prefilter_base(const Env& env, int n, bool trilinear, Executor& ex) {
+    std::vector<vec3<float>> out(std::size_t(6) * std::size_t(n) * std::size_t(n));
+    const prefilter_base_read m = prefilter_base_mode(env, n, trilinear);
     ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-        for (std::size_t row = b; row < e; ++row) {
-            const int face = int(row) / n, y = int(row) % n;
-            for (int x = 0; x < n; ++x) {
-                out[row * std::size_t(n) + std::size_t(x)] =
-                    finite(vec3<Te>(env.radiance(cube_texel_direction<Te>(face, x, y, n), lod)));
-            }
-        }
+        for (std::size_t row = b; row < e; ++row) prefilter_base_row(env, n, m, row, out.data() + row * std::size_t(n));
     });
     return out;
 }

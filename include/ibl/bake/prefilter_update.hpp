@@ -1,0 +1,197 @@
+#pragma once
+// ibl/bake/prefilter_update.hpp — time-sliced prefiltering of a dynamic probe: the chain of
+// bake/prefilter.hpp, computed a bounded amount of work per call (host only).
+//
+// A renderer that re-filters a probe at run time (a captured reflection probe, a sky that changes
+// with the time of day) cannot spend a whole prefilter in one frame. prefilter_update holds the
+// work of one prefilter(source, opt) as a sequence of face rows, level by level (the plan of
+// prefilter_plan: mirror level 0 first, then the rough levels), and step(budget) computes rows
+// until the next row would exceed `budget` source reads ("taps"); a row costs
+//     n_l           taps on a mirror level 0 (one read per texel),
+//     n_l S_l T_l   taps on a convolved level (S_l samples kept after dropping n.l <= 0, T_l = 2
+//                   for trilinear reads, 1 for nearest),
+// so the cost of a call is bounded by max(budget, the dearest row) and proportional to the taps it
+// reports (bench/bench_prefilter.cpp, BM_prefilter_update_step). Every row is computed by exactly
+// the operations prefilter uses (the same tables, the same kernel, the same row order of
+// operations), so the finished chain equals prefilter(source, opt) bit for bit, whatever the
+// budgets of the calls and the executor within a call.
+//
+// Source changes. set_source(c) restarts the pass on the new source (the rows already computed
+// belong to the old one); result() keeps returning the last finished chain until the new pass
+// finishes, so a renderer always reads a complete chain (double buffering). The sample tables are
+// rebuilt only when the source's size or mip count changes (they depend on nothing else).
+//
+// Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
+// level) and pack it into the kernel's layout (passes over its texels); the last step of a pass assembles the chain's cubemap
+// and its borders (one pass over the output texels). Both are linear and small next to the
+// convolution (hundreds of taps per texel).
+//
+// Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
+// prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
+
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <utility>
+#include <vector>
+
+#include "../batch/sphere_kernel.hpp"
+#include "../core/executor.hpp"
+#include "../core/vec.hpp"
+#include "../env/cube_geometry.hpp"
+#include "../env/cubemap.hpp"
+#include "../runtime/chain.hpp"
+#include "../sampling/lobe.hpp"
+#include "prefilter.hpp"
+#include "sphere_convolve.hpp"
+
+namespace ibl {
+
+template <class Lobe = ggx_lobe>
+    requires ld_lobe<Lobe>
+class prefilter_update {
+public:
+    /// Plans the pass of prefilter<Lobe>(source, opt) and starts it. Throws as prefilter.
+    explicit prefilter_update(const cubemap<float>& source, prefilter_options opt = {}) : opt_(std::move(opt)) {
+        set_source(source);
+    }
+
+    /// Restarts the pass on a new source; result() keeps the last finished chain until the new
+    /// pass finishes. Throws as prefilter (a new size may exceed the limits).
+    void set_source(const cubemap<float>& source) {
+        const bool same_shape = source_ && source_->size(0) == source.size(0) && source_->levels() == source.levels();
+        source_ = source;
+        src_ = detail::pack_cube(*source_);
+        if (!same_shape) plan_levels();
+        level_ = 0;
+        row_ = 0;
+        pass_done_ = false;
+    }
+
+    /// Computes face rows until the next would exceed `budget` taps (at least one row when
+    /// budget > 0 and the pass is not finished), through the executor (rows are independent).
+    /// Returns the taps computed; finishing a pass publishes it as result().
+    template <class Executor = serial_executor>
+    std::uint64_t step(std::uint64_t budget, Executor&& ex = Executor{}) {
+        std::uint64_t spent = 0;
+        while (!pass_done_ && budget > 0) {
+            const level_work& lw = levels_[level_];
+            const std::size_t rows_left = std::size_t(6 * lw.n) - row_;
+            std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_left, (budget - spent) / lw.taps_per_row));
+            if (rows == 0 && spent == 0) rows = 1; // progress: one row even above the budget
+            if (rows == 0) break;
+            run_rows(row_, row_ + rows, ex);
+            spent += rows * lw.taps_per_row;
+            row_ += rows;
+            if (row_ == std::size_t(6 * lw.n)) next_level();
+        }
+        return spent;
+    }
+
+    /// Runs the rest of the pass (no budget).
+    template <class Executor = serial_executor> void finish(Executor&& ex = Executor{}) {
+        while (!pass_done_) step(remaining_taps(), ex);
+    }
+
+    /// True after a pass finished and no new one started (set_source restarts).
+    bool done() const noexcept { return pass_done_; }
+    /// The last finished chain (empty before the first pass finishes).
+    const std::optional<specular_chain>& result() const noexcept { return result_; }
+    /// Taps of a whole pass, and those still to compute in the current one.
+    std::uint64_t total_taps() const noexcept {
+        std::uint64_t t = 0;
+        for (const level_work& lw : levels_) t += std::uint64_t(6 * lw.n) * lw.taps_per_row;
+        return t;
+    }
+    std::uint64_t remaining_taps() const noexcept {
+        if (pass_done_) return 0;
+        std::uint64_t t = std::uint64_t(6 * levels_[level_].n - int(row_)) * levels_[level_].taps_per_row;
+        for (std::size_t k = level_ + 1; k < levels_.size(); ++k) t += std::uint64_t(6 * levels_[k].n) * levels_[k].taps_per_row;
+        return t;
+    }
+    /// The pass's plan (prefilter_plan of the options for this source).
+    const std::vector<prefilter_level>& plan() const noexcept { return plan_; }
+    /// Face size of output level k and the taps of one of its rows (k < plan().size()): a budget
+    /// of at least the largest row's taps keeps every call within the budget.
+    int level_size(std::size_t k) const noexcept { return levels_[k].n; }
+    std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
+
+private:
+    struct level_work {
+        int n = 1;
+        bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
+        detail::prefilter_base_read base{};  ///< the mirror level's read
+        detail::tap_table taps{};            ///< a convolved level's taps
+        std::uint64_t taps_per_row = 1;
+        std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
+    };
+
+    void plan_levels() {
+        const int base = detail::prefilter_base_size(*source_, opt_.base_size);
+        plan_ = prefilter_plan<Lobe>(opt_, base);
+        detail::check_prefilter_work(opt_, plan_, base);
+        first_size_ = std::max(1, base >> plan_.front().level);
+        levels_.clear();
+        for (std::size_t k = 0; k < plan_.size(); ++k) {
+            const prefilter_level& lp = plan_[k];
+            level_work lw;
+            lw.n = std::max(1, first_size_ >> int(k));
+            lw.mirror = lobe_mirror_limit<Lobe>() && lp.level == 0;
+            if (lw.mirror) {
+                lw.base = detail::prefilter_base_mode(*source_, lw.n, lp.trilinear);
+                lw.taps_per_row = std::uint64_t(lw.n);
+            } else {
+                sphere_sample_table<float> table =
+                    make_ld_table_for<float, Lobe>(*source_, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight);
+                table.trilinear = lp.trilinear;
+                lw.taps = detail::make_taps(table, int(src_.levels.size()));
+                lw.taps_per_row = std::max<std::uint64_t>(1, std::uint64_t(lw.n) * table.size() * (lp.trilinear ? 2u : 1u));
+            }
+            lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
+            levels_.push_back(std::move(lw));
+        }
+    }
+
+    template <class Executor> void run_rows(std::size_t begin, std::size_t end, Executor& ex) {
+        level_work& lw = levels_[level_];
+        const int n = lw.n;
+        ex(end - begin, [&](std::size_t b, std::size_t e) {
+            for (std::size_t r = begin + b; r < begin + e; ++r) {
+                vec3<float>* out = lw.texels.data() + r * std::size_t(n);
+                if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
+                else detail::convolve_row(src_, lw.taps, int(r) / n, int(r) % n, n, out);
+            }
+        });
+    }
+
+    void next_level() {
+        row_ = 0;
+        if (++level_ < levels_.size()) return;
+        cubemap<float> out(first_size_, int(levels_.size()));
+        for (int k = 0; k < int(levels_.size()); ++k) {
+            const level_work& lw = levels_[std::size_t(k)];
+            out.fill(k, [&](int f, int x, int y) { return lw.texels[cube_texel_index(f, x, y, lw.n)]; });
+        }
+        out.update_borders();
+        result_.emplace(std::move(out), opt_.weight, opt_.policy.mapping);
+        level_ = 0;
+        pass_done_ = true;
+    }
+
+    prefilter_options opt_;
+    std::optional<cubemap<float>> source_;
+    detail::packed_cube src_{};
+    std::vector<prefilter_level> plan_;
+    std::vector<level_work> levels_;
+    int first_size_ = 1;
+    std::size_t level_ = 0, row_ = 0;
+    bool pass_done_ = false;
+    std::optional<specular_chain> result_;
+};
+
+} // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

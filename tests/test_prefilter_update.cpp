@@ -1,0 +1,141 @@
+// bake/prefilter_update: the time-sliced prefilter of a dynamic probe equals the one-shot prefilter
+// bit for bit, whatever the budgets; it keeps the last finished chain across a source change.
+#include <doctest/doctest.h>
+
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/bake/prefilter_update.hpp>
+#include <ibl/core/executor.hpp>
+#include <ibl/env/analytic.hpp>
+#include <ibl/env/convert.hpp>
+#include <ibl/env/cubemap.hpp>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+namespace {
+
+/// Bitwise equality of every texel of every level (the borders follow from the interiors).
+bool same_bits(const ibl::cubemap<float>& a, const ibl::cubemap<float>& b) {
+    if (a.levels() != b.levels()) return false;
+    for (int l = 0; l < a.levels(); ++l) {
+        if (a.size(l) != b.size(l)) return false;
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < a.size(l); ++y)
+                for (int x = 0; x < a.size(l); ++x) {
+                    const ibl::vec3<float> p = a.texel(f, x, y, l), q = b.texel(f, x, y, l);
+                    if (std::memcmp(&p, &q, sizeof p) != 0) return false;
+                }
+    }
+    return true;
+}
+
+ibl::cubemap<float> sky(int n, float sun_scale) {
+    auto s = ibl::make_default_sky<float>();
+    ibl::cubemap<float> c = ibl::bake_cubemap<float>(s, n, 1);
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) c.set_texel(f, x, y, 0, c.texel(f, x, y, 0) * (x == y ? sun_scale : 1.0f));
+    c.generate_mips();
+    return c;
+}
+
+ibl::prefilter_options small_options() {
+    ibl::prefilter_options o;
+    o.samples = 24; // a small table keeps the test fast; the schedule is prefilter's either way
+    return o;
+}
+
+} // namespace
+
+TEST_CASE("prefilter_update: any budget finishes with the one-shot chain, bit for bit") {
+    const ibl::cubemap<float> src = sky(16, 1.0f);
+    const ibl::prefilter_options o = small_options();
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::serial_executor{});
+    for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(700), std::uint64_t(50000), ~std::uint64_t(0) / 2}) {
+        ibl::prefilter_update<> up(src, o);
+        const std::uint64_t total = up.total_taps();
+        std::uint64_t spent = 0, max_spent = 0;
+        int calls = 0;
+        while (!up.done()) {
+            const std::uint64_t s = up.step(budget);
+            CHECK(s > 0);
+            spent += s;
+            max_spent = std::max(max_spent, s);
+            ++calls;
+            REQUIRE(calls < 100000);
+        }
+        CHECK(spent == total);
+        CHECK(up.remaining_taps() == 0);
+        REQUIRE(up.result().has_value());
+        CHECK(same_bits(*up.result(), ref));
+        CHECK(up.result()->weight == ref.weight);
+        // the number of calls is predictable: a call computes max(1, budget / row taps) rows of a
+        // level (and goes on to the next level with what is left), and never exceeds the budget
+        // unless one row alone does
+        std::uint64_t bound = 0, largest_row = 0;
+        for (std::size_t k = 0; k < up.plan().size(); ++k) {
+            const std::uint64_t rows = 6 * std::uint64_t(up.level_size(k));
+            const std::uint64_t per_call = std::max<std::uint64_t>(1, budget / up.row_taps(k));
+            bound += (rows + per_call - 1) / per_call;
+            largest_row = std::max(largest_row, up.row_taps(k));
+        }
+        CHECK(std::uint64_t(calls) <= bound);
+        if (budget >= largest_row) CHECK(max_spent <= budget);
+    }
+}
+
+TEST_CASE("prefilter_update: an executor within a call, a level plan, the G1 weight and the Charlie lobe") {
+    const ibl::cubemap<float> src = sky(8, 3.0f);
+    ibl::prefilter_options o = small_options();
+    o.weight = ibl::ld_weight::g1;
+    o.level_plan = {{1, 0.3, 16, true}, {2, 0.6, 32, false}, {3, 1.0, 8, true}};
+    const ibl::specular_chain ref = ibl::prefilter(src, o);
+    ibl::prefilter_update<> up(src, o);
+    while (!up.done()) up.step(900, ibl::thread_executor{2});
+    CHECK(same_bits(*up.result(), ref));
+
+    ibl::prefilter_options c = small_options();
+    const ibl::specular_chain cref = ibl::prefilter<ibl::charlie_lobe>(src, c);
+    ibl::prefilter_update<ibl::charlie_lobe> cu(src, c);
+    cu.finish();
+    CHECK(same_bits(*cu.result(), cref));
+}
+
+TEST_CASE("prefilter_update: a source change restarts the pass; the last finished chain stays readable") {
+    const ibl::cubemap<float> a = sky(16, 1.0f), b = sky(16, 40.0f);
+    const ibl::prefilter_options o = small_options();
+    ibl::prefilter_update<> up(a, o);
+    CHECK_FALSE(up.result().has_value());
+    up.finish();
+    const ibl::specular_chain ref_a = ibl::prefilter(a, o), ref_b = ibl::prefilter(b, o);
+    CHECK(same_bits(*up.result(), ref_a));
+    up.step(up.total_taps() / 3);
+    up.set_source(b); // mid-pass: the rows of a are dropped
+    CHECK_FALSE(up.done());
+    CHECK(up.remaining_taps() == up.total_taps());
+    up.step(up.total_taps() / 2);
+    CHECK(same_bits(*up.result(), ref_a)); // still the finished chain of a
+    up.finish();
+    CHECK(same_bits(*up.result(), ref_b));
+    // a source of another size re-plans (smaller chain) and still matches
+    const ibl::cubemap<float> s8 = sky(8, 2.0f);
+    up.set_source(s8);
+    up.finish();
+    CHECK(same_bits(*up.result(), ibl::prefilter(s8, o)));
+}
+
+TEST_CASE("prefilter_update: budget 0 does nothing; bad options throw as prefilter does") {
+    const ibl::cubemap<float> src = sky(8, 1.0f);
+    ibl::prefilter_update<> up(src, small_options());
+    CHECK(up.step(0) == 0);
+    CHECK(up.remaining_taps() == up.total_taps());
+    ibl::prefilter_options bad = small_options();
+    bad.level_plan = {{1, 0.3, 16, true}, {3, 0.6, 16, true}};
+    CHECK_THROWS_AS(ibl::prefilter_update<>(src, bad), std::invalid_argument);
+    bad = small_options();
+    bad.levels = -3;
+    CHECK_THROWS_AS(ibl::prefilter_update<>(src, bad), std::invalid_argument);
+}
