@@ -77,7 +77,7 @@ public:
     template <class Executor = serial_executor>
     std::uint64_t step(std::uint64_t budget, Executor&& ex = Executor{}) {
         std::uint64_t spent = 0;
-        while (!pass_done_ && budget > 0) {
+        while (!pass_done_ && spent < budget) {
             const level_work& lw = levels_[level_];
             const std::size_t rows_left = std::size_t(6 * lw.n) - row_;
             std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_left, (budget - spent) / lw.taps_per_row));
