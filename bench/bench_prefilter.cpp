@@ -182,12 +182,7 @@ template <std::size_t W> void convolve_level(const ibl::detail::packed_cube& src
         const int face = row / n, y = row % n;
         for (int x = 0; x < n; x += int(W)) {
             ibl::detail::lane_frames<W> fr;
-            for (std::size_t k = 0; k < W; ++k) {
-                const ibl::frame<float> f = ibl::make_frame(ibl::cube_texel_direction<float>(face, x + int(k), y, n));
-                fr.tx[k] = f.t.x, fr.ty[k] = f.t.y, fr.tz[k] = f.t.z;
-                fr.bx[k] = f.b.x, fr.by[k] = f.b.y, fr.bz[k] = f.b.z;
-                fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
-            }
+            for (std::size_t k = 0; k < W; ++k) ibl::detail::load_lane_frame(fr, k, face, x + int(k), y, n);
             ibl::detail::convolve_lanes<W>(src, taps, fr, out.data() + std::size_t(row) * std::size_t(n) + std::size_t(x));
         }
     }

@@ -190,24 +190,27 @@ void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_fr
 /// Lane width of the fast path (a face row is processed in chunks of W, the tail at width 1).
 inline constexpr std::size_t convolve_width = 8;
 
+/// Lane k of fr: the tangent frame of texel (x, y) of face `face` of an n x n level.
+template <std::size_t W>
+inline void load_lane_frame(lane_frames<W>& fr, std::size_t k, int face, int x, int y, int n) noexcept {
+    const frame<float> f = make_frame(cube_texel_direction<float>(face, x, y, n));
+    fr.tx[k] = f.t.x, fr.ty[k] = f.t.y, fr.tz[k] = f.t.z;
+    fr.bx[k] = f.b.x, fr.by[k] = f.b.y, fr.bz[k] = f.b.z;
+    fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
+}
+
 /// Convolves row y of face `face` of an n x n output level into out[0..n).
 inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
     constexpr std::size_t W = convolve_width;
-    auto load = [&](auto& fr, std::size_t k, int x) {
-        const frame<float> f = make_frame(cube_texel_direction<float>(face, x, y, n));
-        fr.tx[k] = f.t.x, fr.ty[k] = f.t.y, fr.tz[k] = f.t.z;
-        fr.bx[k] = f.b.x, fr.by[k] = f.b.y, fr.bz[k] = f.b.z;
-        fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
-    };
     int x = 0;
     for (; x + int(W) <= n; x += int(W)) {
         lane_frames<W> fr;
-        for (std::size_t k = 0; k < W; ++k) load(fr, k, x + int(k));
+        for (std::size_t k = 0; k < W; ++k) load_lane_frame(fr, k, face, x + int(k), y, n);
         convolve_lanes<W>(src, taps, fr, out + x);
     }
     for (; x < n; ++x) {
         lane_frames<1> fr;
-        load(fr, 0, x);
+        load_lane_frame(fr, 0, face, x, y, n);
         convolve_lanes<1>(src, taps, fr, out + x);
     }
 }
