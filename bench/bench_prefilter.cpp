@@ -1,6 +1,6 @@
 // bake/prefilter and irradiance: the cost of the prefiltered mip chain (256^2 source -> 5
 // levels, linear roughness policy) against its error, sweeping samples per texel for plain GGX
-// importance sampling (IS) and filtered importance sampling (FIS), on
+// importance sampling (IS), filtered importance sampling (FIS) and the fast filter, on
 //   env 0: the default sky without its sun (smooth), baked to 256^2 (k = 2);
 //   env 1: the default sky with its 1-degree sun (3e4), baked to 256^2 with k = 4 sub-samples.
 // Counters per level l = 1..4 (level 0 is the source copy): rel_l (RMS of per-element relative
@@ -101,6 +101,25 @@ void BM_prefilter_fis(benchmark::State& state) {
     o.method = ibl::prefilter_method::filtered_importance;
     o.samples = std::uint32_t(state.range(1));
     o.trilinear = false;
+    run_chain(state, o, int(state.range(0)));
+}
+
+/// The fast filter (bake/prefilter_fast.hpp) at the same samples per texel and the same
+/// nearest-level reads as the FIS sweep: the error-vs-time frontier of the two side by side.
+void BM_prefilter_fast(benchmark::State& state) {
+    ibl::prefilter_options o;
+    o.levels = levels;
+    o.method = ibl::prefilter_method::fast;
+    o.samples = std::uint32_t(state.range(1));
+    o.trilinear = false;
+    run_chain(state, o, int(state.range(0)));
+}
+
+/// The fast filter's default schedule (32 samples at level 1, doubled per level, trilinear reads,
+/// automatic levels as BM_prefilter_default): the ratio of the two defaults is measured in one run.
+void BM_prefilter_fast_default(benchmark::State& state) {
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
     run_chain(state, o, int(state.range(0)));
 }
 
@@ -221,6 +240,12 @@ BENCHMARK(BM_prefilter_fis)
     ->ArgsProduct({{0, 1}, {16, 32, 64, 128, 256}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
+BENCHMARK(BM_prefilter_fast)
+    ->ArgNames({"env", "spp"})
+    ->ArgsProduct({{0, 1}, {16, 32, 64, 128, 256}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_prefilter_fast_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_is)
     ->ArgNames({"env", "spp"})
     ->ArgsProduct({{0, 1}, {64, 256, 1024}})

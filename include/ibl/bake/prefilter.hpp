@@ -105,6 +105,7 @@
 #include "../runtime/chain.hpp"
 #include "../runtime/ld_weight.hpp"
 #include "../runtime/roughness_mip.hpp"
+#include "prefilter_fast.hpp"
 #include "sphere_convolve.hpp"
 
 namespace ibl {
@@ -112,6 +113,7 @@ namespace ibl {
 enum class prefilter_method : int {
     importance = 0,          ///< GGX importance sampling, every sample reads level 0
     filtered_importance = 1, ///< Krivanek-Colbert filtered importance sampling
+    fast = 2,                ///< the fast filter: a small tap set shaped offline (bake/prefilter_fast.hpp)
 };
 
 /// One output level of a prefilter plan (prefilter_options::level_plan, prefilter_plan).
@@ -172,6 +174,7 @@ inline std::uint32_t doubling_prefilter_samples(std::uint32_t level1_samples, in
 /// doubling schedule from 512 at level 1 for filtered importance sampling (ibl-bake's default
 /// quality, with trilinear reads), from 1024 (the literature's count) for plain importance sampling.
 inline std::uint32_t default_prefilter_samples(prefilter_method method, int level) {
+    if (method == prefilter_method::fast) return doubling_prefilter_samples(fast_default_samples, level);
     return doubling_prefilter_samples(method == prefilter_method::importance ? 1024u : 512u, level);
 }
 
@@ -212,9 +215,13 @@ sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::
                                          prefilter_method method, double lod_bias,
                                          ld_weight weight = ld_weight::n_dot_l) {
     detail::check_total("make_ld_table_for", "samples", samples, limits::max_samples, "limits::max_samples");
+    using Te = std::conditional_t<environment<Env, float>, float, double>;
+    if (method == prefilter_method::fast)
+        return make_fast_ld_table<S, Lobe>(roughness, samples, fast_shape(roughness, samples, weight), [&](double omega) -> double {
+            return double(env_lod_for_solid_angle<Te>(env, Te(omega)));
+        }, weight);
     return make_ld_table<S, Lobe>(roughness, samples, [&](double omega_s) -> double {
         if (method == prefilter_method::importance) return 0.0;
-        using Te = std::conditional_t<environment<Env, float>, float, double>;
         // The bias b scales the footprint by 4^b: 0.5 log2(4^b Omega_s / Omega_0) = lod + b.
         const double omega = omega_s * std::exp2(2.0 * lod_bias);
         return double(env_lod_for_solid_angle<Te>(env, Te(omega)));

@@ -50,6 +50,7 @@ const char* to_string(level_layout l) noexcept { return std::array{"faces", "lat
 const char* to_string(input_form f) noexcept {
     return std::array{"auto", "latlong", "hcross", "vcross", "hstrip", "vstrip", "faces", "ktx2"}[std::size_t(f)];
 }
+const char* to_string(prefilter_choice p) noexcept { return std::array{"fis", "fast"}[std::size_t(p)]; }
 const char* to_string(ktx2_storage f) noexcept { return std::array{"rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"}[std::size_t(f)]; }
 
 std::string to_string(const sh_window_choice& w) {
@@ -199,6 +200,7 @@ option_map convention_options() {
         {"--specular-lookup", {true, [](bake_options& o, const std::string& v) {
              o.specular_lookup = choice("--specular-lookup", v, {ibl::specular_lookup_desc::textbook(), ibl::specular_lookup_desc::accurate()});
          }}},
+        {"--prefilter", {true, [](bake_options& o, const std::string& v) { o.prefilter = choice("--prefilter", v, {prefilter_choice::fis, prefilter_choice::fast}); }}},
         {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {ibl::ld_weight::g1, ibl::ld_weight::n_dot_l}); }}},
         {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {runtime_choice::lobe, runtime_choice::taps2, runtime_choice::split_sum}); }}},
     };
@@ -339,6 +341,7 @@ std::string usage_text() {
            "  --sheen            also the Charlie sheen chain and the sheen albedo LUT\n"
            "  --dfg-layout L     uniform (default: texel centres in n.v, r) | remapped (cbrt n.v, sqrt r)\n"
            "  --specular-lookup S  textbook (default: textureLod at lod(r)) | accurate (log-geometric)\n"
+           "  --prefilter M      fis (default: filtered importance sampling) | fast (the fast filter)\n"
            "  --ld-weight W      nl (default: Karis D n.l) | g1 (D G1, the true lobe at n.v = 1)\n"
            "  --runtime M        split-sum (default: LD(R, r) DFG) | lobe (lobe LUT) | taps2 (two fitted taps)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"

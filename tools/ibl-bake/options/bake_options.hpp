@@ -34,6 +34,8 @@
 //   --dfg-layout L      uniform (default: texel centres in (n.v, r)) | remapped (cbrt(n.v) x sqrt(r),
 //                       edge-aligned)
 //   --specular-lookup S textbook (default: textureLod at lod(r)) | accurate (log-geometric two-level blend)
+//   --prefilter M       fis (default: filtered importance sampling, 512 * 2^(l-1) samples) | fast (the
+//                       fast filter, bake/prefilter_fast.hpp: 32 * 2^(l-1) samples; --quality scales both)
 //   --ld-weight W       nl (default: Karis's D n.l) | g1 (D G1, the lobe at n.v = 1): the chain's weight
 //   --runtime M         split-sum (default: LD(R, r) DFG) | lobe (the lobe LUT, lobe_lut.exr) | taps2
 //                       (the fitted two-tap model, lobe_taps_a.exr, lobe_taps_b.exr)
@@ -86,6 +88,8 @@ enum class runtime_choice { split_sum, lobe, taps2 };
 enum class level_layout { faces, latlong, cross, octahedral };
 /// --input-layout: how --input is read (automatic: from its name and aspect ratio).
 enum class input_form { automatic, latlong, hcross, vcross, hstrip, vstrip, faces, ktx2 };
+/// --prefilter: the specular chain's filter (fis: filtered importance sampling; fast: the fast filter).
+enum class prefilter_choice { fis, fast };
 /// --ktx2-format: the storage of the KTX2 files (ktx2.hpp's ktx2_format of the same names).
 enum class ktx2_storage { rgba16f, rgba32f, b10g11r11, e5b9g9r9 };
 
@@ -106,6 +110,7 @@ const char* to_string(runtime_choice r) noexcept;
 const char* to_string(level_layout l) noexcept;
 const char* to_string(input_form f) noexcept;
 const char* to_string(ktx2_storage f) noexcept;
+const char* to_string(prefilter_choice p) noexcept;
 std::string to_string(const sh_window_choice& w);
 /// "g1" | "nl"
 const char* to_string(ibl::ld_weight w) noexcept;
@@ -144,6 +149,7 @@ struct bake_options {
     /// textbook (textureLod at lod(r)) | accurate (log-geometric); its mapping is the plan's policy's
     ibl::specular_lookup_desc specular_lookup = ibl::specular_lookup_desc::textbook();
     ibl::ld_weight ld_weight = ibl::ld_weight::n_dot_l; ///< the chain's LD weight: nl (Karis) | g1
+    prefilter_choice prefilter = prefilter_choice::fis; ///< --prefilter: the chain's filter
     runtime_choice runtime = runtime_choice::split_sum;
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)

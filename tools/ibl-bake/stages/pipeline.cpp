@@ -79,6 +79,7 @@ void report_options(json_writer& j, const bake_context& ctx) {
     j.key("quality").value(ctx.qs.name);
     j.key("threads").value(ctx.ex.threads());
     j.key("ktx2_format").value(to_string(o.ktx2_format));
+    j.key("prefilter").value(to_string(o.prefilter));
     j.key("checks").value(to_string(o.checks));
     j.end_object();
     // the sizes baked (a scene's plan may use less than --size and --lut-size); level 0 = the mirror level

@@ -403,14 +403,20 @@ void json_triples(json_writer& j, const sh5& c, int count) {
     j.end_array();
 }
 
+std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method) {
+    return method == prefilter_choice::fast ? std::max<std::uint32_t>(8, fis_samples / fast_samples_divisor) : fis_samples;
+}
+
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex) {
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
+                               prefilter_choice method) {
     ibl::prefilter_options o;
     o.base_size = sp.virtual_base_size;
     o.policy = sp.policy;
     o.weight = w;
+    o.method = method == prefilter_choice::fast ? ibl::prefilter_method::fast : ibl::prefilter_method::filtered_importance;
     for (const ibl::specular_level_plan& lp : sp.levels) // the mirror level copies the nearest source level
-        o.level_plan.push_back({lp.level, lp.roughness, lp.samples, lp.level > 0 && lp.trilinear});
+        o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method), lp.level > 0 && lp.trilinear});
     return ibl::cubemap<float>(ibl::prefilter(src, o, ex));
 }
 

@@ -85,7 +85,8 @@ public:
     void run(bake_context& ctx) override {
         ctx.prog.begin("prefilter");
         weight_ = ctx.opt.ld_weight;
-        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex);
+        method_ = ctx.opt.prefilter;
+        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_);
         ms_ = ctx.prog.end();
         chain_ = &*ctx.chain;
         sp_ = ctx.plan.specular;
@@ -130,6 +131,7 @@ private:
     }
     quality_settings qs_{};
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
+    prefilter_choice method_ = prefilter_choice::fis;
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
     bool checked_ = true;
     std::vector<level_check> checks_;
@@ -179,12 +181,14 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
 }
 
 std::vector<table_row> specular_stage::rows() const {
+    const bool fast = method_ == prefilter_choice::fast;
     const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
-                                ? std::to_string(qs_.prefilter_samples) + "*2^(l-1) spp"
+                                ? std::to_string(chain_samples(qs_.prefilter_samples, method_)) + "*2^(l-1) spp"
                                 : "planned spp";
-    const std::string method = std::string("GGX filtered IS") + (sp_.trilinear ? " (trilinear)" : "");
+    const std::string method = std::string(fast ? "GGX fast filter" : "GGX filtered IS") + (sp_.trilinear ? " (trilinear)" : "");
+    const std::string brief = fast ? "GGX fast filter" : "GGX filtered IS";
     const std::string cost = spp + ", " + std::to_string(sp_.levels.size()) + " levels";
-    if (!checked_) return {table_row{"specular chain", method, cost, ms_, "not checked (--checks none)"}.compact("GGX filtered IS", "not checked")};
+    if (!checked_) return {table_row{"specular chain", method, cost, ms_, "not checked (--checks none)"}.compact(brief, "not checked")};
     double worst_rel = 0.0, worst_over = 0.0;
     int worst_l = 0;
     for (const auto& c : checks_)
@@ -196,7 +200,7 @@ std::vector<table_row> specular_stage::rows() const {
     std::vector<table_row> rows;
     rows.push_back(table_row{"specular chain", method, cost, ms_,
                              any ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) + fmt(", max overshoot %.3g", worst_over) : "-"}
-                       .compact("GGX filtered IS", any ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) : "-")
+                       .compact(brief, any ? fmt2("worst rel RMSE %.3g (level %.0f)", worst_rel, worst_l) : "-")
                        .alarm(worst_rel, alarm_relative,
                               "levels > 5% off the exact LD: more samples (--quality high), or --extract-sun on for a sun"));
     double qmax = 0.0, qrms = 0.0;
@@ -261,14 +265,21 @@ void specular_stage::report(json_writer& j) const {
     j.key("ktx2_quantisation");
     if (checked_) json_quantisation(j, quant_, format_);
     else j.null();
-    j.key("method").value(std::string("GGX filtered importance sampling (Krivanek-Colbert), ") +
+    j.key("prefilter").value(to_string(method_));
+    j.key("method").value(std::string(method_ == prefilter_choice::fast
+                                          ? "GGX fast filter (ibl::prefilter_method::fast: polar tap sets shaped offline, "
+                                            "read from the exact-solid-angle mips), "
+                                          : "GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
     j.key("ld_weight").value(to_string(weight_));
-    j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? sp_.levels[1].samples : 0u);
+    j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? chain_samples(sp_.levels[1].samples, method_) : 0u);
     j.key("samples_per_level").begin_array();
-    for (const auto& l : sp_.levels) j.value(l.samples);
-    j.end_array().key("lod_bias").value(0.5).end_object();
+    for (const auto& l : sp_.levels) j.value(chain_samples(l.samples, method_));
+    j.end_array();
+    if (method_ == prefilter_choice::fast) j.key("lod_bias").value("per level: the fast table's shape (ibl::fast_shape)");
+    else j.key("lod_bias").value(0.5);
+    j.end_object();
     j.key("time_ms").value(ms_);
     j.key("mip_policy").value(sp_.policy.mapping == ibl::roughness_mapping::filament
                                   ? "filament: roughness r at virtual lod v = (V - 1) r (2 - r) of V levels; stored level = v - first_level"
@@ -300,7 +311,7 @@ void specular_stage::report_levels(json_writer& j) const {
         j.key("virtual_level").value(lp.level);
         j.key("size").value(chain_->size(int(k)));
         j.key("roughness").value(lp.roughness);
-        j.key("samples").value(lp.samples);
+        j.key("samples").value(chain_samples(lp.samples, method_));
         j.key("trilinear").value(lp.trilinear);
         if (c) {
             j.key("texels_compared").value(c->texels);

@@ -208,7 +208,14 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
 
 /// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
 /// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex);
+/// The fast filter's samples per level are the plan's (filtered importance sampling's) / 16, at
+/// least 8: 32 * 2^(l - 1) at the default quality (ibl::fast_default_samples).
+inline constexpr std::uint32_t fast_samples_divisor = 16;
+/// The samples a level of the chain is filtered with: the plan's for fis, the fast filter's for fast.
+std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method);
+/// The plan's chain filtered by `method` (ibl::prefilter with a level plan).
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
+                               prefilter_choice method = prefilter_choice::fis);
 
 /// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);

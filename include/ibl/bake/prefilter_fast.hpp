@@ -1,0 +1,207 @@
+#pragma once
+// ibl/bake/prefilter_fast.hpp — the fast filter: a small deterministic tap set per roughness,
+// shaped offline against the exact LD kernel, read from the source's exact-solid-angle mip chain
+// (host only). prefilter() runs it with prefilter_options::method = prefilter_method::fast; it
+// shares the chain, the level plan, the LD weights, the lobes and the kernel of filtered
+// importance sampling (bake/prefilter.hpp), and only the table differs.
+//
+// Derivation. The LD kernel of a lobe L about R (bake/prefilter.hpp) depends only on the angle
+// theta between l and R: with h = (sin(theta/2), 0, cos(theta/2)) in tangent space,
+//     K(theta) = pdf_l(h) w(cos theta) L::ld_weight(h),   w = n.l (Karis) or G1(n.l) (ld_weight::g1),
+// and LD(R) = integral L(l) K dl / integral K dl over theta < pi/2. The fast table is a spiral
+// quadrature of K with N samples: sample i sits at the radius where the radial CDF
+//     C(theta) = integral_0^theta K sin / integral_0^(pi/2) K sin
+// reaches g((i + 1/2) / N), g(x) = 1 - (1 - x)^tail (tail > 1 moves samples into the heavy GGX
+// tail), at azimuth i times the golden angle; its weight is its kernel mass g((i + 1)/N) - g(i/N)
+// and it reads the source at the lod of its share of the sphere, mass / density,
+//     lod = 0.5 log2(Omega_i 4^lod_bias / Omega_0),
+// the filtered importance sampling rule (Krivanek-Colbert) with the quadrature's cells. Unlike
+// Hammersley draws, the spiral has no noise: every radius of the CDF is visited once, in order.
+// The CDF is tabulated on 4097 geometric radii (trapezoid rule in double).
+//
+// The shape (tail, lod_bias) per LD weight, roughness and N is fitted offline
+// (research/fast_filter_fit.cpp, which writes bake/prefilter_fast_tables.hpp): for a 256^2
+// source that is one bright texel (at a face centre, on an edge, at a corner), the L1 norm of
+// the filter's response minus the exact response (the kernel integrated over the texel) over the
+// sphere, relative to the exact response's. That is the error on a point light at any position,
+// and a source is a sum of texels. fast_shape() picks the row of the nearest tabulated roughness
+// and the largest tabulated N within the level's samples; the table is then built with the
+// level's samples. Each row records filtered importance sampling's error at the same N: the
+// fitted shapes are below it at every row.
+//
+// Cost: N samples per texel (two bilinear taps each with trilinear reads), the default schedule
+// fast_default_samples * 2^(l - 1) against 512 * 2^(l - 1) for filtered importance sampling.
+// Error and time: docs/ibl-bake.md ("Fast filter") and bench/bench_prefilter.cpp.
+//
+// Determinism: the table depends only on the roughness, N, the weight and the source's lod
+// mapping; the kernel and the work partition are those of the filtered importance sampling path,
+// so prefilter and prefilter_update give the same bits.
+
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "../brdf/ggx.hpp"
+#include "../core/constants.hpp"
+#include "../core/limits.hpp"
+#include "../core/vec.hpp"
+#include "../runtime/ld_weight.hpp"
+#include "../sampling/lobe.hpp"
+#include "prefilter_fast_tables.hpp"
+#include "sphere_convolve.hpp"
+
+namespace ibl {
+
+/// The lobe's angular scale s(r) = 2 atan(max(r^2, 1e-3)): the angle of l where GGX falls to a
+/// quarter of its peak (the radial CDF's grid starts at 1e-6 s(r)).
+inline double fast_lobe_scale(double roughness) noexcept {
+    return 2.0 * std::atan(std::max(alpha_from_roughness(roughness), 1e-3));
+}
+
+/// Samples per texel at level 1 of the fast filter's default schedule (doubling per level, as
+/// default_prefilter_samples): a sixteenth of filtered importance sampling's default, about a
+/// tenth of its time (docs/ibl-bake.md, "Fast filter", has the error this costs).
+inline constexpr std::uint32_t fast_default_samples = 32;
+
+/// The tabulated shape (bake/prefilter_fast_tables.hpp) for a weight, a roughness and a sample
+/// budget: among the rows of that weight, those of the largest tabulated budget <= samples (the
+/// smallest budget when none is), at the tabulated roughness nearest to r (r clamped to [0, 1];
+/// ties to the smaller). An empty table gives the default shape.
+inline fast_tap_shape fast_shape(double roughness, std::uint32_t samples, ld_weight weight = ld_weight::n_dot_l,
+                                 std::span<const fast_shape_row> rows = fast_shape_rows) noexcept {
+    const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
+    std::uint32_t budget = 0, smallest = 0xffffffffu;
+    for (const fast_shape_row& row : rows) {
+        if (row.weight != weight) continue;
+        smallest = std::min(smallest, row.budget);
+        if (row.budget <= samples) budget = std::max(budget, row.budget);
+    }
+    if (budget == 0) budget = smallest;
+    const fast_shape_row* best = nullptr;
+    for (const fast_shape_row& row : rows)
+        if (row.weight == weight && row.budget == budget &&
+            (!best || std::fabs(row.roughness - r) < std::fabs(best->roughness - r)))
+            best = &row;
+    return best ? best->shape : fast_tap_shape{};
+}
+
+namespace detail {
+/// The LD kernel of lobe L at angle theta from R (per unit solid angle of l, not normalised).
+template <class Lobe> double fast_kernel(double theta, double roughness, ld_weight weight) noexcept {
+    const double n_dot_l = std::cos(theta);
+    if (!(n_dot_l > 0.0)) return 0.0;
+    const vec3<double> h(std::sin(0.5 * theta), 0.0, std::cos(0.5 * theta));
+    const double w = weight == ld_weight::g1 ? g1_smith_ggx(n_dot_l, alpha_from_roughness(roughness)) : n_dot_l;
+    const double k = lobe_ld_pdf<Lobe>(h, roughness) * w * Lobe::ld_weight(h, roughness);
+    return std::isfinite(k) && k > 0.0 ? k : 0.0;
+}
+
+/// Integrals over theta in [a, b] of K sin(theta) and of theta^2 K sin(theta) (Simpson, 2 m
+/// intervals; in log theta when a > 0).
+template <class Lobe>
+void fast_ring_moments(double a, double b, double roughness, ld_weight weight, double& mass, double& second) noexcept {
+    constexpr int m = 64;
+    mass = 0.0, second = 0.0;
+    const bool log_scale = a > 0.0;
+    const double u0 = log_scale ? std::log(a) : a, u1 = log_scale ? std::log(b) : b;
+    const double du = (u1 - u0) / double(2 * m);
+    for (int i = 0; i <= 2 * m; ++i) {
+        const double u = u0 + du * double(i);
+        const double t = log_scale ? std::exp(u) : u;
+        const double jac = log_scale ? t : 1.0;
+        const double c = (i == 0 || i == 2 * m) ? 1.0 : (i % 2 ? 4.0 : 2.0);
+        const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t) * jac * c;
+        mass += f;
+        second += f * t * t;
+    }
+    mass *= du / 3.0;
+    second *= du / 3.0;
+}
+} // namespace detail
+
+namespace detail {
+/// The radial CDF of the LD kernel: C(theta) = integral_0^theta K sin / integral_0^(pi/2) K sin on
+/// a grid (theta_0 = 0, then geometric from 1e-6 s(r) to pi/2), by the trapezoid rule in log theta.
+struct fast_radial_cdf {
+    std::vector<double> theta, cdf, m2; ///< m2: the running integral of theta^2 K sin (unnormalised)
+    double total = 0.0;
+};
+template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_weight weight) {
+    constexpr int m = 4096;
+    fast_radial_cdf c;
+    const double lo = 1e-6 * fast_lobe_scale(roughness), hi = 0.5 * pi_v<double>;
+    c.theta.push_back(0.0);
+    c.cdf.push_back(0.0);
+    c.m2.push_back(0.0);
+    double prev_t = 0.0, prev_f = 0.0, acc = 0.0, acc2 = 0.0;
+    for (int i = 0; i <= m; ++i) {
+        const double t = lo * std::pow(hi / lo, double(i) / m);
+        const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t);
+        acc += 0.5 * (f + prev_f) * (t - prev_t);
+        acc2 += 0.5 * (f * t * t + prev_f * prev_t * prev_t) * (t - prev_t);
+        c.theta.push_back(t);
+        c.cdf.push_back(acc);
+        c.m2.push_back(acc2);
+        prev_t = t, prev_f = f;
+    }
+    c.total = acc;
+    for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
+    return c;
+}
+/// Linear interpolation of theta (and the running second moment) at CDF value u.
+inline void fast_cdf_at(const fast_radial_cdf& c, double u, double& theta, double& m2) {
+    const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
+    if (it == c.cdf.begin()) { theta = 0.0, m2 = 0.0; return; }
+    if (it == c.cdf.end()) { theta = c.theta.back(), m2 = c.m2.back(); return; }
+    const std::size_t k = std::size_t(it - c.cdf.begin());
+    const double d = c.cdf[k] - c.cdf[k - 1];
+    const double f = d > 0.0 ? (u - c.cdf[k - 1]) / d : 0.0;
+    theta = c.theta[k - 1] + f * (c.theta[k] - c.theta[k - 1]);
+    m2 = c.m2[k - 1] + f * (c.m2[k] - c.m2[k - 1]);
+}
+} // namespace detail
+
+/// The fast filter's table of lobe L (GGX by default) for one roughness, sample count and shape
+/// (the header's spiral quadrature): tangent-space tap directions, kernel masses as weights, lods
+/// from lod_of_solid_angle(Omega_i 4^lod_bias). Computed in double, stored as S. samples = 0 reads
+/// as 1; a tail exponent that is not finite and > 0 reads as 1.
+template <class S, class Lobe = ggx_lobe, class LodFn>
+    requires ld_lobe<Lobe>
+sphere_sample_table<S> make_fast_ld_table(double roughness, std::uint32_t samples, const fast_tap_shape& shape,
+                                          LodFn&& lod_of_solid_angle, ld_weight weight = ld_weight::n_dot_l) {
+    detail::check_total("make_fast_ld_table", "samples", samples, limits::max_samples, "limits::max_samples");
+    const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
+    const std::uint32_t n = std::max<std::uint32_t>(1, samples);
+    const double tail = std::isfinite(shape.tail) && shape.tail > 0.0 ? shape.tail : 1.0;
+    const double bias4 = std::exp2(2.0 * (std::isfinite(shape.lod_bias) ? shape.lod_bias : 0.0));
+    const detail::fast_radial_cdf cdf = detail::make_fast_radial_cdf<Lobe>(r, weight);
+    const double norm = 2.0 * pi_v<double> * cdf.total; // integral of K over the sphere
+    constexpr double golden = 2.399963229728653;         // pi (3 - sqrt 5)
+    auto warp = [&](double x) { return 1.0 - std::pow(1.0 - x, tail); };
+    sphere_sample_table<S> t;
+    t.drawn = n;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const double u0 = warp(double(i) / double(n)), u1 = i + 1 == n ? 1.0 : warp(double(i + 1) / double(n));
+        const double mass = u1 - u0;
+        double theta = 0.0, m2 = 0.0;
+        detail::fast_cdf_at(cdf, warp((double(i) + 0.5) / double(n)), theta, m2);
+        const double k = detail::fast_kernel<Lobe>(theta, r, weight);
+        if (!(mass > 0.0) || !(k > 0.0) || !(norm > 0.0)) continue;
+        const double omega = mass / (k / norm); // the sample's share of the sphere: its mass / density
+        const double phi = golden * double(i);
+        const double st = std::sin(theta), ct = std::cos(theta);
+        t.push(vec3<S>(S(st * std::cos(phi)), S(st * std::sin(phi)), S(ct)), S(mass), S(lod_of_solid_angle(omega * bias4)));
+    }
+    if (t.size() == 0) t.push(vec3<S>(S(0), S(0), S(1)), S(1), S(lod_of_solid_angle(0.0))); // a kernel with no mass: the mirror
+    return t;
+}
+
+} // namespace ibl
+
+#endif // IBL_DETAIL_CXX20

@@ -1,0 +1,324 @@
+// research/fast_filter_fit.cpp — the offline fit of the fast filter's tap shapes
+// (include/ibl/bake/prefilter_fast.hpp), which writes include/ibl/bake/prefilter_fast_tables.hpp.
+//
+//   build/dev/research/fast_filter_fit --write-header include/ibl/bake/prefilter_fast_tables.hpp
+//   build/dev/research/fast_filter_fit --show R BUDGET      one fit, every candidate's error
+//   build/dev/research/fast_filter_fit --fis --show R N     filtered importance sampling's error
+//   build/dev/research/fast_filter_fit --check              re-fits two rows of the compiled-in
+//                                                           table; fails when they differ (ctest)
+//
+// Objective (the header's derivation): a 256^2 source that is one bright texel, at a face
+// centre, on an edge and at a corner; its exact LD response at direction R is the kernel about R
+// integrated over the source's bilinear reconstruction of that texel (8 x 8 sub-samples of the
+// 3 x 3 texels around it, exact sub-sample solid angles), and the filter's response is the fast
+// table read through the source's exact-solid-angle mips with trilinear reads, as prefilter
+// reads them. The error is the L1 norm of the difference over R (rings about the texel's
+// direction out to pi/2 + 0.5, 16 azimuths), relative to the L1 norm of the exact response, mean
+// over the three positions. A source is a sum of texels, so this bounds the relative error of
+// the filter on any source, and it is the error on a point light (a sun).
+//
+// Search per (weight, roughness, samples N): the spiral's tail exponent on a grid of 6 and the
+// lod bias on a grid of 9 (-0.5 .. 1.5), then a local refinement of both about the best point.
+// Roughness 0.05 .. 1 in steps of 0.05; N = 8 .. 256 (powers of two); both LD weights. Each row
+// also records filtered importance sampling's error with the same N (bias 0.5, Hammersley).
+// 240 fits take about 2 minutes on 2 cores (release build).
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/core/frame.hpp>
+#include <ibl/env/cube_geometry.hpp>
+#include <ibl/env/cubemap.hpp>
+
+namespace {
+
+constexpr int source_size = 256;
+constexpr int sub = 8;
+
+struct probe {
+    ibl::cubemap<float> cube{1, 1};
+    ibl::vec3<double> dir{};
+    std::vector<ibl::vec3<double>> pts; ///< sub-sample directions of the 3 x 3 texels
+    std::vector<double> val;            ///< bilinear reconstruction of the bright texel x solid angle
+};
+
+probe make_probe(int face, int x, int y) {
+    probe p;
+    const int n = source_size;
+    p.cube = ibl::cubemap<float>(n, 0);
+    p.cube.fill(0, [&](int f, int tx, int ty) {
+        return ibl::vec3<float>(f == face && tx == x && ty == y ? 1.f : 0.f);
+    });
+    p.cube.generate_mips();
+    p.dir = ibl::cube_texel_direction<double>(face, x, y, n);
+    // Sub-samples of the 3 x 3 texels around (x, y) on the same face (the probes sit where the
+    // 3 x 3 block may cross an edge: those sub-samples are read through the cube's seamless
+    // lookup, so the reconstruction is the one the source has).
+    for (int ty = y - 1; ty <= y + 1; ++ty)
+        for (int tx = x - 1; tx <= x + 1; ++tx)
+            for (int j = 0; j < sub; ++j)
+                for (int i = 0; i < sub; ++i) {
+                    const double u = (double(tx) + (i + 0.5) / sub) / n * 2.0 - 1.0;
+                    const double v = (double(ty) + (j + 0.5) / sub) / n * 2.0 - 1.0;
+                    if (std::fabs(u) > 1.0 || std::fabs(v) > 1.0) continue; // off the face: outside the reconstruction's support there
+                    const ibl::vec3<double> d = glm::normalize(ibl::cube_face_point<double>(face, u, v));
+                    const double l = double(p.cube.radiance(ibl::vec3<float>(d), 0.f).x);
+                    if (!(l > 0.0)) continue;
+                    const double da = (2.0 / (n * sub)) * (2.0 / (n * sub)) / std::pow(1.0 + u * u + v * v, 1.5);
+                    p.pts.push_back(d);
+                    p.val.push_back(l * da);
+                }
+    return p;
+}
+
+struct rdir {
+    ibl::vec3<double> d;
+    double w; ///< solid angle it stands for
+};
+
+/// Output directions about dir: rings at angles from 0 out to pi/2 + 0.5, 16 azimuths.
+std::vector<rdir> make_dirs(const ibl::vec3<double>& dir, double scale) {
+    std::vector<rdir> out;
+    const ibl::frame<double> fr = ibl::make_frame(dir);
+    const double lo = std::max(0.05 * scale, 1e-4), hi = 0.5 * ibl::pi_v<double> + 0.5;
+    constexpr int rings = 56, az = 16;
+    double prev = 0.0;
+    out.push_back({dir, 0.0});
+    std::vector<double> edges;
+    for (int i = 0; i <= rings; ++i) edges.push_back(lo * std::pow(hi / lo, double(i) / rings));
+    out[0].w = 2.0 * ibl::pi_v<double> * (1.0 - std::cos(0.5 * edges[0]));
+    prev = 0.5 * edges[0];
+    for (int i = 0; i <= rings; ++i) {
+        const double rho = edges[std::size_t(i)];
+        const double next = i < rings ? 0.5 * (rho + edges[std::size_t(i) + 1]) : rho;
+        const double ring = 2.0 * ibl::pi_v<double> * (std::cos(prev) - std::cos(next));
+        for (int j = 0; j < az; ++j) {
+            const double phi = 2.0 * ibl::pi_v<double> * (j + 0.25 * (i % 4)) / az;
+            out.push_back({fr.to_world(ibl::vec3<double>(std::sin(rho) * std::cos(phi), std::sin(rho) * std::sin(phi), std::cos(rho))),
+                           ring / az});
+        }
+        prev = next;
+    }
+    return out;
+}
+
+struct fit_case {
+    ibl::ld_weight weight;
+    double roughness;
+    std::uint32_t budget;
+};
+
+struct evaluator {
+    const std::vector<probe>* probes;
+    fit_case c;
+    std::vector<std::vector<rdir>> dirs;
+    std::vector<std::vector<double>> exact; ///< per probe, per direction: exact response
+    std::vector<double> exact_l1;
+
+    void init() {
+        const double norm = [&] {
+            double m = 0.0, s2 = 0.0, total = 0.0;
+            const double s = ibl::fast_lobe_scale(c.roughness);
+            double a = 0.0;
+            for (int i = 0; i < 40; ++i) { // [0, s/8], then geometric pieces to pi/2
+                const double b = i == 39 ? 0.5 * ibl::pi_v<double> : std::min(0.5 * ibl::pi_v<double>, s / 8.0 * std::pow(2.0, 0.5 * i));
+                if (b <= a) continue;
+                ibl::detail::fast_ring_moments<ibl::ggx_lobe>(a, b, c.roughness, c.weight, m, s2);
+                total += m;
+                a = b;
+            }
+            return 2.0 * ibl::pi_v<double> * total;
+        }();
+        for (const probe& p : *probes) {
+            dirs.push_back(make_dirs(p.dir, ibl::fast_lobe_scale(c.roughness)));
+            std::vector<double> e;
+            double l1 = 0.0;
+            for (const rdir& r : dirs.back()) {
+                double acc = 0.0;
+                for (std::size_t k = 0; k < p.pts.size(); ++k) {
+                    const double cosang = std::clamp(glm::dot(r.d, p.pts[k]), -1.0, 1.0);
+                    acc += p.val[k] * ibl::detail::fast_kernel<ibl::ggx_lobe>(std::acos(cosang), c.roughness, c.weight);
+                }
+                e.push_back(acc / norm);
+                l1 += acc / norm * r.w;
+            }
+            exact.push_back(std::move(e));
+            exact_l1.push_back(l1);
+        }
+    }
+
+    double error(const ibl::fast_tap_shape& shape) const {
+        return error_of([&](const probe& p) {
+            return ibl::make_fast_ld_table<double>(
+                c.roughness, c.budget, shape, [&](double omega) { return double(p.cube.lod_for_solid_angle(float(omega))); }, c.weight);
+        });
+    }
+    /// The same error for filtered importance sampling with N samples (bias 0.5, trilinear).
+    double error_fis(std::uint32_t samples) const {
+        return error_of([&](const probe& p) {
+            return ibl::make_ld_table_for<double>(p.cube, c.roughness, samples, ibl::prefilter_method::filtered_importance, 0.5, c.weight);
+        });
+    }
+    template <class MakeTable> double error_of(MakeTable&& make_table) const {
+        double total = 0.0;
+        for (std::size_t pi = 0; pi < probes->size(); ++pi) {
+            const probe& p = (*probes)[pi];
+            const ibl::sphere_sample_table<double> t = make_table(p);
+            double wsum = 0.0;
+            for (double w : t.weight) wsum += w;
+            double l1 = 0.0;
+            for (std::size_t k = 0; k < dirs[pi].size(); ++k) {
+                const rdir& r = dirs[pi][k];
+                const ibl::frame<double> fr = ibl::make_frame(r.d);
+                double acc = 0.0;
+                for (std::size_t i = 0; i < t.size(); ++i) {
+                    const ibl::vec3<double> l = fr.to_world(ibl::vec3<double>(t.x[i], t.y[i], t.z[i]));
+                    acc += t.weight[i] * double(p.cube.radiance(ibl::vec3<float>(l), float(t.lod[i])).x);
+                }
+                l1 += std::fabs(acc / wsum - exact[pi][k]) * r.w;
+            }
+            total += l1 / exact_l1[pi];
+        }
+        return total / double(probes->size());
+    }
+};
+
+struct fit_result {
+    fit_case c;
+    ibl::fast_tap_shape shape;
+    double l1 = 0.0;
+    double fis_l1 = 0.0; ///< filtered importance sampling (bias 0.5) with the same samples
+};
+
+fit_result fit(const std::vector<probe>& probes, const fit_case& c, bool show) {
+    evaluator ev{&probes, c, {}, {}, {}};
+    ev.init();
+    fit_result best{c, {}, 1e30, 0.0};
+    for (double tail : {0.7, 0.85, 1.0, 1.2, 1.5, 2.0})
+        for (double bias = -0.5; bias <= 1.51; bias += 0.25) {
+            const ibl::fast_tap_shape s{tail, bias};
+            const double e = ev.error(s);
+            if (show) std::printf("tail %.2f bias %+.2f  L1 %.4f\n", tail, bias, e);
+            if (e < best.l1) best.shape = s, best.l1 = e;
+        }
+    // Local refinement of (tail, bias) about the best grid point.
+    double dt = 0.1, db = 0.125;
+    for (int it = 0; it < 14; ++it) {
+        bool moved = false;
+        for (const auto& [kt, kb] : std::array<std::pair<double, double>, 4>{{{1, 0}, {-1, 0}, {0, 1}, {0, -1}}}) {
+            ibl::fast_tap_shape s = best.shape;
+            s.tail *= std::exp(kt * dt);
+            s.lod_bias += kb * db;
+            const double e = ev.error(s);
+            if (e < best.l1) best.shape = s, best.l1 = e, moved = true;
+        }
+        if (!moved) dt *= 0.5, db *= 0.5;
+    }
+    best.fis_l1 = ev.error_fis(c.budget);
+    return best;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    std::string header;
+    double show_r = -1.0;
+    std::uint32_t show_budget = 0;
+    bool fis = false, check = false;
+    for (int i = 1; i < argc; ++i) {
+        if (!std::strcmp(argv[i], "--write-header") && i + 1 < argc) header = argv[++i];
+        else if (!std::strcmp(argv[i], "--fis")) fis = true;
+        else if (!std::strcmp(argv[i], "--check")) check = true;
+        else if (!std::strcmp(argv[i], "--show") && i + 2 < argc) show_r = std::atof(argv[i + 1]), show_budget = std::uint32_t(std::atoi(argv[i + 2])), i += 2;
+        else {
+            std::fprintf(stderr, "usage: fast_filter_fit [--write-header PATH] [--fis] [--show R N] [--check]\n");
+            return 2;
+        }
+    }
+    const int n = source_size;
+    std::vector<probe> probes;
+    probes.push_back(make_probe(4, n / 2, n / 2));     // face centre
+    probes.push_back(make_probe(4, n - 1, n / 2 + 3)); // on an edge
+    probes.push_back(make_probe(4, n - 1, n - 1));     // at a corner
+    if (check) {
+        int bad = 0;
+        for (const fit_case& c : {fit_case{ibl::ld_weight::n_dot_l, 0.5, 16}, fit_case{ibl::ld_weight::g1, 0.3, 8}}) {
+            const fit_result r = fit(probes, c, false);
+            for (const ibl::fast_shape_row& row : ibl::fast_shape_rows) {
+                if (row.weight != c.weight || row.budget != c.budget || std::fabs(row.roughness - c.roughness) > 1e-9) continue;
+                const bool same = std::fabs(row.shape.tail - r.shape.tail) < 1e-3 && std::fabs(row.shape.lod_bias - r.shape.lod_bias) < 1e-3 &&
+                                  std::fabs(row.l1 - r.l1) < 1e-3;
+                std::printf("%s r %.2f N %u: table tail %.4f bias %+.4f L1 %.4f, refit %.4f %+.4f %.4f: %s\n",
+                            c.weight == ibl::ld_weight::g1 ? "g1" : "nl", c.roughness, c.budget, row.shape.tail, row.shape.lod_bias,
+                            row.l1, r.shape.tail, r.shape.lod_bias, r.l1, same ? "same" : "DIFFERENT");
+                bad += same ? 0 : 1;
+            }
+        }
+        return bad ? 1 : 0;
+    }
+    if (show_r >= 0.0 && fis) {
+        evaluator ev{&probes, {ibl::ld_weight::n_dot_l, show_r, show_budget}, {}, {}, {}};
+        ev.init();
+        std::printf("fis r %.2f samples %u: L1 %.4f\n", show_r, show_budget, ev.error_fis(show_budget));
+        return 0;
+    }
+    if (show_r >= 0.0) {
+        const fit_result r = fit(probes, {ibl::ld_weight::n_dot_l, show_r, show_budget}, true);
+        std::printf("best: tail %.4f bias %+.4f  L1 %.4f (FIS with %u samples: %.4f)\n", r.shape.tail, r.shape.lod_bias, r.l1,
+                    show_budget, r.fis_l1);
+        return 0;
+    }
+    std::vector<fit_case> cases;
+    for (ibl::ld_weight w : {ibl::ld_weight::n_dot_l, ibl::ld_weight::g1})
+        for (int ri = 1; ri <= 20; ++ri)
+            for (std::uint32_t b : {8u, 16u, 32u, 64u, 128u, 256u}) cases.push_back({w, 0.05 * ri, b});
+    std::vector<fit_result> results(cases.size());
+    std::atomic<std::size_t> next{0};
+    auto work = [&] {
+        for (std::size_t k; (k = next++) < cases.size();) {
+            results[k] = fit(probes, cases[k], false);
+            std::fprintf(stderr, "%s r %.2f samples %3u: tail %.3f bias %+.3f  L1 %.4f  FIS L1 %.4f\n",
+                         cases[k].weight == ibl::ld_weight::g1 ? "g1 " : "n.l", cases[k].roughness, cases[k].budget,
+                         results[k].shape.tail, results[k].shape.lod_bias, results[k].l1, results[k].fis_l1);
+        }
+    };
+    std::thread other(work);
+    work();
+    other.join();
+    if (header.empty()) return 0;
+    std::ofstream f(header);
+    f << "#pragma once\n"
+         "// ibl/bake/prefilter_fast_tables.hpp — the fast filter's tap shapes (bake/prefilter_fast.hpp), per\n"
+         "// LD weight, roughness and sample budget, and each shape's point-light error (relative L1).\n"
+         "// Generated by research/fast_filter_fit.cpp (`fast_filter_fit --write-header PATH`); do not edit.\n\n"
+         "#include \"../core/config.hpp\" // first: a pre-C++20 build stops there with one #error\n"
+         "#if IBL_DETAIL_CXX20\n\n#include <cstdint>\n\n#include \"../runtime/ld_weight.hpp\"\n\nnamespace ibl {\n\n"
+         "/// One fast-filter table shape (bake/prefilter_fast.hpp): the spiral's tail exponent and lod bias.\n"
+         "struct fast_tap_shape {\n    double tail = 1.0;\n    double lod_bias = 0.5;\n};\n\n"
+         "/// A tabulated shape: its LD weight, roughness and samples, the relative L1 error of its\n"
+         "/// point-light response (the fit's objective) and that of filtered importance sampling with\n"
+         "/// the same samples (bias 0.5, Hammersley).\n"
+         "struct fast_shape_row {\n    ld_weight weight = ld_weight::n_dot_l;\n    double roughness = 0.0;\n"
+         "    std::uint32_t budget = 0;\n    fast_tap_shape shape{};\n    double l1 = 0.0;\n    double fis_l1 = 0.0;\n};\n\n"
+         "inline constexpr fast_shape_row fast_shape_rows[] = {\n";
+    char line[256];
+    for (const fit_result& r : results) {
+        std::snprintf(line, sizeof line, "    {ld_weight::%s, %.2f, %u, {%.4f, %.4f}, %.4f, %.4f},\n",
+                      r.c.weight == ibl::ld_weight::g1 ? "g1" : "n_dot_l", r.c.roughness, r.c.budget, r.shape.tail,
+                      r.shape.lod_bias, r.l1, r.fis_l1);
+        f << line;
+    }
+    f << "};\n\n} // namespace ibl\n\n#endif // IBL_DETAIL_CXX20\n";
+    std::printf("wrote %s (%zu shapes)\n", header.c_str(), results.size());
+    return 0;
+}
