@@ -85,6 +85,16 @@ void run_chain(benchmark::State& state, const ibl::prefilter_options& o, int env
     report(state, out, env);
 }
 
+/// A sweep point: `levels` levels, range(1) samples at every level >= 1, nearest-level reads.
+void run_sweep(benchmark::State& state, ibl::prefilter_method method) {
+    ibl::prefilter_options o;
+    o.levels = levels;
+    o.method = method;
+    o.samples = std::uint32_t(state.range(1));
+    o.trilinear = false;
+    run_chain(state, o, int(state.range(0)));
+}
+
 /// args: env, samples per texel (every level >= 1). The FIS sweeps read the nearest level (one
 /// tap per sample, as docs/results was measured); the default options read trilinearly.
 void BM_prefilter_is(benchmark::State& state) {
@@ -95,37 +105,23 @@ void BM_prefilter_is(benchmark::State& state) {
     run_chain(state, o, int(state.range(0)));
 }
 
-void BM_prefilter_fis(benchmark::State& state) {
-    ibl::prefilter_options o;
-    o.levels = levels;
-    o.method = ibl::prefilter_method::filtered_importance;
-    o.samples = std::uint32_t(state.range(1));
-    o.trilinear = false;
-    run_chain(state, o, int(state.range(0)));
-}
+void BM_prefilter_fis(benchmark::State& state) { run_sweep(state, ibl::prefilter_method::filtered_importance); }
 
 /// The fast filter (bake/prefilter_fast.hpp) at the same samples per texel and the same
 /// nearest-level reads as the FIS sweep: the error-vs-time frontier of the two side by side.
-void BM_prefilter_fast(benchmark::State& state) {
+void BM_prefilter_fast(benchmark::State& state) { run_sweep(state, ibl::prefilter_method::fast); }
+
+/// The default schedules at the sweeps' `levels` levels (the references' roughness per level):
+/// FIS (bias 0.5, trilinear reads, 512 samples at level 1 doubled per level) and the fast filter
+/// (32 at level 1 doubled, trilinear reads); the ratio of the two is measured in one run.
+void run_default(benchmark::State& state, ibl::prefilter_method method) {
     ibl::prefilter_options o;
     o.levels = levels;
-    o.method = ibl::prefilter_method::fast;
-    o.samples = std::uint32_t(state.range(1));
-    o.trilinear = false;
+    o.method = method;
     run_chain(state, o, int(state.range(0)));
 }
-
-/// The fast filter's default schedule (32 samples at level 1, doubled per level, trilinear reads,
-/// automatic levels as BM_prefilter_default): the ratio of the two defaults is measured in one run.
-void BM_prefilter_fast_default(benchmark::State& state) {
-    ibl::prefilter_options o;
-    o.method = ibl::prefilter_method::fast;
-    run_chain(state, o, int(state.range(0)));
-}
-
-/// The default options (FIS, bias 0.5, 5 levels, trilinear reads, 512 samples at level 1 doubled
-/// per level).
-void BM_prefilter_default(benchmark::State& state) { run_chain(state, ibl::prefilter_options{}, int(state.range(0))); }
+void BM_prefilter_fast_default(benchmark::State& state) { run_default(state, ibl::prefilter_method::fast); }
+void BM_prefilter_default(benchmark::State& state) { run_default(state, ibl::prefilter_method::filtered_importance); }
 
 /// FIS at 128 nearest-level samples, sweeping the lod bias (in tenths).
 void BM_prefilter_fis_bias(benchmark::State& state) {

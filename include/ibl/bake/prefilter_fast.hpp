@@ -102,34 +102,12 @@ template <class Lobe> double fast_kernel(double theta, double roughness, ld_weig
     return std::isfinite(k) && k > 0.0 ? k : 0.0;
 }
 
-/// Integrals over theta in [a, b] of K sin(theta) and of theta^2 K sin(theta) (Simpson, 2 m
-/// intervals; in log theta when a > 0).
-template <class Lobe>
-void fast_ring_moments(double a, double b, double roughness, ld_weight weight, double& mass, double& second) noexcept {
-    constexpr int m = 64;
-    mass = 0.0, second = 0.0;
-    const bool log_scale = a > 0.0;
-    const double u0 = log_scale ? std::log(a) : a, u1 = log_scale ? std::log(b) : b;
-    const double du = (u1 - u0) / double(2 * m);
-    for (int i = 0; i <= 2 * m; ++i) {
-        const double u = u0 + du * double(i);
-        const double t = log_scale ? std::exp(u) : u;
-        const double jac = log_scale ? t : 1.0;
-        const double c = (i == 0 || i == 2 * m) ? 1.0 : (i % 2 ? 4.0 : 2.0);
-        const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t) * jac * c;
-        mass += f;
-        second += f * t * t;
-    }
-    mass *= du / 3.0;
-    second *= du / 3.0;
-}
-} // namespace detail
 
-namespace detail {
 /// The radial CDF of the LD kernel: C(theta) = integral_0^theta K sin / integral_0^(pi/2) K sin on
-/// a grid (theta_0 = 0, then geometric from 1e-6 s(r) to pi/2), by the trapezoid rule in log theta.
+/// a grid (theta_0 = 0, then geometric from 1e-6 s(r) to pi/2), by the trapezoid rule in theta.
+/// total = integral_0^(pi/2) K sin (the kernel's integral over the sphere is 2 pi total).
 struct fast_radial_cdf {
-    std::vector<double> theta, cdf, m2; ///< m2: the running integral of theta^2 K sin (unnormalised)
+    std::vector<double> theta, cdf;
     double total = 0.0;
 };
 template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_weight weight) {
@@ -138,32 +116,28 @@ template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_
     const double lo = 1e-6 * fast_lobe_scale(roughness), hi = 0.5 * pi_v<double>;
     c.theta.push_back(0.0);
     c.cdf.push_back(0.0);
-    c.m2.push_back(0.0);
-    double prev_t = 0.0, prev_f = 0.0, acc = 0.0, acc2 = 0.0;
+    double prev_t = 0.0, prev_f = 0.0, acc = 0.0;
     for (int i = 0; i <= m; ++i) {
         const double t = lo * std::pow(hi / lo, double(i) / m);
         const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t);
         acc += 0.5 * (f + prev_f) * (t - prev_t);
-        acc2 += 0.5 * (f * t * t + prev_f * prev_t * prev_t) * (t - prev_t);
         c.theta.push_back(t);
         c.cdf.push_back(acc);
-        c.m2.push_back(acc2);
         prev_t = t, prev_f = f;
     }
     c.total = acc;
     for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
     return c;
 }
-/// Linear interpolation of theta (and the running second moment) at CDF value u.
-inline void fast_cdf_at(const fast_radial_cdf& c, double u, double& theta, double& m2) {
+/// The radius where the CDF reaches u (linear between grid points).
+inline double fast_cdf_at(const fast_radial_cdf& c, double u) noexcept {
     const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
-    if (it == c.cdf.begin()) { theta = 0.0, m2 = 0.0; return; }
-    if (it == c.cdf.end()) { theta = c.theta.back(), m2 = c.m2.back(); return; }
+    if (it == c.cdf.begin()) return 0.0;
+    if (it == c.cdf.end()) return c.theta.back();
     const std::size_t k = std::size_t(it - c.cdf.begin());
     const double d = c.cdf[k] - c.cdf[k - 1];
     const double f = d > 0.0 ? (u - c.cdf[k - 1]) / d : 0.0;
-    theta = c.theta[k - 1] + f * (c.theta[k] - c.theta[k - 1]);
-    m2 = c.m2[k - 1] + f * (c.m2[k] - c.m2[k - 1]);
+    return c.theta[k - 1] + f * (c.theta[k] - c.theta[k - 1]);
 }
 } // namespace detail
 
@@ -189,8 +163,7 @@ sphere_sample_table<S> make_fast_ld_table(double roughness, std::uint32_t sample
     for (std::uint32_t i = 0; i < n; ++i) {
         const double u0 = warp(double(i) / double(n)), u1 = i + 1 == n ? 1.0 : warp(double(i + 1) / double(n));
         const double mass = u1 - u0;
-        double theta = 0.0, m2 = 0.0;
-        detail::fast_cdf_at(cdf, warp((double(i) + 0.5) / double(n)), theta, m2);
+        const double theta = detail::fast_cdf_at(cdf, warp((double(i) + 0.5) / double(n)));
         const double k = detail::fast_kernel<Lobe>(theta, r, weight);
         if (!(mass > 0.0) || !(k > 0.0) || !(norm > 0.0)) continue;
         const double omega = mass / (k / norm); // the sample's share of the sphere: its mass / density

@@ -13,6 +13,7 @@
 #include "io/json_value.hpp"
 #include "io/ktx2.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -125,4 +126,40 @@ TEST_CASE("presets: filament and gltf change the documented conventions") {
     const auto gl = ibl_examples::parse_json(slurp(s / "gltf/report.json"));
     CHECK(gl.find("source")->find("brightest_direction")->values[0].number == doctest::Approx(br[0].number));
     CHECK(gl.find("specular")->find("levels")->values[1].find("roughness")->number == doctest::Approx(1.0 / 3.0));
+}
+
+TEST_CASE("--prefilter fast: the chain by the fast filter, named in report.json with the samples it used") {
+    scratch s("ibl_bake_prefilter_tests");
+    const std::string base = tool + " --quiet --size 32 --lut-size 8 ";
+    REQUIRE(shell(base + "--prefilter fast --out " + (s / "fast") + " >/dev/null") == 0);
+    REQUIRE(shell(base + "--out " + (s / "fis") + " >/dev/null") == 0);
+    const auto fast = ibl_examples::parse_json(slurp(s / "fast/report.json"));
+    const auto fis = ibl_examples::parse_json(slurp(s / "fis/report.json"));
+    CHECK(fast.find("options")->find("prefilter")->string == "fast");
+    CHECK(fis.find("options")->find("prefilter")->string == "fis");
+    CHECK(fast.find("specular")->find("prefilter")->string == "fast");
+    CHECK(fast.find("specular")->find("method")->string.rfind("GGX fast filter", 0) == 0);
+    const auto& lf = fast.find("specular")->find("levels")->values;
+    const auto& li = fis.find("specular")->find("levels")->values;
+    REQUIRE(lf.size() == li.size());
+    REQUIRE(lf.size() >= 3);
+    for (std::size_t l = 1; l < lf.size(); ++l) {
+        CAPTURE(l);
+        // The fast filter's samples are the plan's / 16 (at least 8): 32 * 2^(l - 1) at the default quality.
+        CHECK(lf[l].find("samples")->number == std::max(8.0, li[l].find("samples")->number / 16.0));
+        CHECK(lf[l].find("samples")->number == 32.0 * std::exp2(double(l - 1)));
+        // Checked at the same texels against the same reference as the FIS chain.
+        CHECK(std::isfinite(lf[l].find("rel_rmse")->number));
+        CHECK(lf[l].find("texels_compared")->number == li[l].find("texels_compared")->number);
+    }
+    // More samples (--quality high: 128 * 2^(l - 1)) give a smaller error on every level >= 1.
+    REQUIRE(shell(base + "--prefilter fast --quality high --out " + (s / "high") + " >/dev/null") == 0);
+    const auto high = ibl_examples::parse_json(slurp(s / "high/report.json"));
+    const auto& lh = high.find("specular")->find("levels")->values;
+    REQUIRE(lh.size() == lf.size());
+    for (std::size_t l = 1; l < lf.size(); ++l) {
+        CAPTURE(l);
+        CHECK(lh[l].find("rel_rmse")->number < lf[l].find("rel_rmse")->number);
+    }
+    CHECK(shell(base + "--prefilter slow --out " + (s / "bad") + " >/dev/null 2>&1") == 2);
 }
