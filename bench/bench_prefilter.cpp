@@ -214,7 +214,9 @@ void BM_convolve_width(benchmark::State& state) {
     std::vector<ibl::vec3<float>> out(std::size_t(6 * n * n)), scalar(out.size());
     convolve_level<1>(src, taps, n, scalar);
     for (auto _ : state) {
-        if (state.range(0) == 8) convolve_level<8>(src, taps, n, out);
+        if (state.range(0) == 16) convolve_level<16>(src, taps, n, out);
+        else if (state.range(0) == 8) convolve_level<8>(src, taps, n, out);
+        else if (state.range(0) == 4) convolve_level<4>(src, taps, n, out);
         else convolve_level<1>(src, taps, n, out);
         benchmark::DoNotOptimize(out.data());
     }
@@ -228,7 +230,7 @@ void BM_convolve_width(benchmark::State& state) {
 
 } // namespace
 
-BENCHMARK(BM_convolve_width)->ArgName("W")->Arg(1)->Arg(8)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_convolve_width)->ArgName("W")->Arg(1)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget"})->ArgsProduct({{1}, {16, 18, 20}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)

@@ -53,5 +53,10 @@ void main() {
               ibl_lobe_tap_direction(u_n, it, ibl_lobe_tap_angle(0.5, u_r));
     float so = ibl_specular_occlusion_table(u_so, dot(u_n, u_v), u_r, 0.5) +
                ibl_specular_occlusion_bent(u_so, u_n, u_v, it, u_r, 0.5) + ibl_specular_occlusion_coord(0.5, u_r, 0.5, 8).z;
-    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so, 1.0);
+    int pf_face;
+    float pf_s, pf_t;
+    ibl_cube_face_st(u_l, pf_face, pf_s, pf_t);
+    vec3 pf = ibl_prefilter_texel(u_taps_a, u_taps_b, u_taps, 1.0, u_n) + ibl_cube_texel_direction(pf_face, 1, 2, 8) +
+              ibl_packed_texel(u_taps_a, 3).xyz * (pf_s + pf_t);
+    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so + pf, 1.0);
 }

@@ -12,6 +12,9 @@
 #include <string>
 #include <vector>
 
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/env/analytic.hpp>
+#include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
 #include <ibl/reference/occluded_specular.hpp>
@@ -847,9 +850,63 @@ void print_fixtures() {
     std::printf("]}}\n");
 }
 
+/// The prefilter test's fixtures (tools/viewer/prefilter.frag.glsl, ibl_prefilter.glsl): the default
+/// sky baked to 32^2 and packed as the C++ kernel reads it (detail::pack_cube, 256 texels per
+/// row), and per convolved level of the fast filter's chain (ibl::prefilter, method fast, default
+/// plan) its single-level taps as the kernel runs them (make_ld_table_for + detail::make_taps, what
+/// prefilter builds) and the chain's texels (face, row, column) the GLSL must reproduce.
+void print_prefilter_fixtures() {
+    constexpr int size = 32, width = 256;
+    const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
+    const ibl::detail::packed_cube packed = ibl::detail::pack_cube(src);
+    const std::size_t texels = packed.data.size() / 4, height = (texels + width - 1) / width;
+    std::printf("{\"width\": %d, \"height\": %zu, \"packed\": [", width, height);
+    for (std::size_t k = 0; k < width * height * 4; ++k)
+        std::printf("%s%.9g", k ? ", " : "", k < packed.data.size() ? double(packed.data[k]) : 0.0);
+    std::printf("], \"levels\": [");
+    const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(o, size);
+    bool first = true;
+    for (std::size_t l = 0; l < plan.size(); ++l) {
+        const ibl::prefilter_level& lp = plan[l];
+        if (lp.level == 0) continue; // the mirror level is a copy
+        ibl::sphere_sample_table<float> table =
+            ibl::make_ld_table_for<float>(src, lp.roughness, lp.samples, o.method, o.lod_bias, o.weight);
+        table.trilinear = lp.trilinear;
+        const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
+        const int n = chain.size(int(l));
+        std::printf("%s{\"level\": %d, \"n\": %d, \"count\": %zu, \"factor\": %.9g, \"taps\": [", first ? "" : ", ",
+                    int(l), n, taps.w.size(), double(taps.factor));
+        first = false;
+        for (std::size_t i = 0; i < taps.w.size(); ++i)
+            std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]), double(taps.z[i]),
+                        double(taps.w[i]));
+        std::printf("], \"info\": [");
+        for (std::size_t i = 0; i < taps.w.size(); ++i) {
+            const ibl::detail::packed_cube::level& lv = packed.levels[std::size_t(taps.level[i])];
+            std::printf("%s%d, %d, %d, %d", i ? ", " : "", lv.n, lv.stride, lv.face_stride, lv.offset);
+        }
+        std::printf("], \"expect\": [");
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) {
+                    const ibl::vec3<float> v = chain.texel(f, x, y, int(l));
+                    std::printf("%s%.9g, %.9g, %.9g", f || y || x ? ", " : "", double(v.x), double(v.y), double(v.z));
+                }
+        std::printf("]}");
+    }
+    std::printf("]}\n");
+}
+
 int main(int argc, char** argv) {
     if (argc > 1 && std::strcmp(argv[1], "--fixtures") == 0) {
         print_fixtures();
+        return 0;
+    }
+    if (argc > 1 && std::strcmp(argv[1], "--prefilter-fixtures") == 0) {
+        print_prefilter_fixtures();
         return 0;
     }
     // tap_from_h (the tap rows' bounds perturb its h) must be fis_tap's body: same taps, bit for bit.

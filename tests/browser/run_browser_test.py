@@ -10,6 +10,11 @@ SwiftShader's WebGL2), compared with the C++.
            preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
            interactive viewer to --out (docs/shaders-viewer.png).
+  prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
+           fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 32^2, packed,
+           and the fast filter's taps per level) and compares every texel of every convolved level
+           with the C++ chain (ibl::prefilter, method fast) within half-float rounding: |GLSL - C++|
+           <= 2^-11 |C++| per value.
   numeric  lets tools/viewer/numeric.frag.glsl evaluate the GLSL functions on a fixed grid of
            inputs and compares them with the same grid evaluated by the library in C++
            (glsl_reference, tests/browser/glsl_reference.cpp); the page uploads the fixtures
@@ -410,11 +415,38 @@ def compare_numeric(reference_exe, result):
     return ok
 
 
+def compare_prefilter(fixtures, result):
+    ok = True
+    by_level = {lv["level"]: lv for lv in result["levels"]}
+    for lv in fixtures["levels"]:
+        got = by_level.get(lv["level"])
+        expect = lv["expect"]
+        if got is None or len(got["rgb"]) != len(expect):
+            print(f"level {lv['level']}: missing or wrong size")
+            ok = False
+            continue
+        worst, bad = 0.0, 0
+        for i, (e, g) in enumerate(zip(expect, got["rgb"])):
+            lim = 2.0 ** -11 * abs(e)
+            ratio = abs(g - e) / lim if lim > 0 else abs(g - e)
+            worst = max(worst, ratio)
+            if not abs(g - e) <= lim:
+                if bad < 3:
+                    print(f"  level {lv['level']} value {i}: GLSL {g!r} C++ {e!r}")
+                bad += 1
+        print(f"level {lv['level']} ({lv['n']}^2 x 6, {lv['count']} taps): worst |diff| / (2^-11 |C++|) {worst:.3g}, "
+              f"{bad} values outside")
+        ok = ok and bad == 0
+    print(f"renderer: {result.get('renderer')}")
+    print("PASS" if ok else "FAIL")
+    return ok
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=["preview", "numeric", "screenshot"], required=True)
+    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "screenshot"], required=True)
     ap.add_argument("--tool", help="ibl-bake (preview)")
-    ap.add_argument("--reference", help="glsl_reference (numeric)")
+    ap.add_argument("--reference", help="glsl_reference (numeric, prefilter)")
     ap.add_argument("--chromium", default="chromium")
     ap.add_argument("--repo", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
     ap.add_argument("--size", default="32", help="face size of the preview test's bake")
@@ -438,6 +470,10 @@ def main():
         if a.mode == "numeric":  # the runtime rows' fixtures (a chain and a table), served to the page
             fixtures = subprocess.run([a.reference, "--fixtures"], check=True, capture_output=True, text=True).stdout
             open(os.path.join(bake_dir, "numeric_fixtures.json"), "w").write(fixtures)
+        if a.mode == "prefilter":  # the source, the taps and the C++ chain, served to the page
+            prefilter_fixtures = subprocess.run([a.reference, "--prefilter-fixtures"], check=True, capture_output=True,
+                                                text=True).stdout
+            open(os.path.join(bake_dir, "prefilter_fixtures.json"), "w").write(prefilter_fixtures)
         server = Server(os.path.abspath(a.repo), bake_dir)
         if a.mode == "screenshot":
             try:
@@ -464,6 +500,8 @@ def main():
                 os.makedirs(a.keep, exist_ok=True)
                 shutil.copytree(bake_dir, os.path.join(a.keep, "bake"), dirs_exist_ok=True)
                 open(os.path.join(a.keep, "browser_rgb.bin"), "wb").write(base64.b64decode(result["rgb"]))
+        elif a.mode == "prefilter":
+            ok = compare_prefilter(json.loads(prefilter_fixtures), result)
         else:
             ok = compare_numeric(a.reference, result)
         return 0 if ok else 1

@@ -171,7 +171,7 @@ async function fetchText(url) {
 
 async function libraryGlsl() {
     const parts = [];
-    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl', 'ibl_runtime.glsl']) parts.push(await fetchText(glslBase + f));
+    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl', 'ibl_runtime.glsl', 'ibl_prefilter.glsl']) parts.push(await fetchText(glslBase + f));
     return parts.join('\n');
 }
 
@@ -498,6 +498,57 @@ async function runNumericTest() {
     await post({ kind: 'numeric', width: W, height: H, values: Array.from(out), renderer: rendererName(gl) });
 }
 
+/// The prefilter test: the fast filter's chain of the fixtures (glsl_reference --prefilter-fixtures)
+/// rendered by ibl_prefilter.glsl, one pass per face and level into an RGBA32F target; the texels
+/// are posted in the chain's order (level, face, row, column).
+async function runPrefilterTest() {
+    const canvas = document.getElementById('view');
+    const gl = canvas.getContext('webgl2');
+    if (!gl) throw new Error('WebGL2 is not available');
+    if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to render float results');
+    const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('prefilter.frag.glsl')));
+    const fx = JSON.parse(await fetchText(params.get('bake') + 'prefilter_fixtures.json'));
+    const texture = (unit, w, h, data) => {
+        const t = gl.createTexture();
+        gl.activeTexture(gl.TEXTURE0 + unit);
+        gl.bindTexture(gl.TEXTURE_2D, t);
+        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, w, h, 0, gl.RGBA, gl.FLOAT, new Float32Array(data));
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+        return t;
+    };
+    gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
+    texture(0, fx.width, fx.height, fx.packed);
+    gl.useProgram(program);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_src'), 0);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_taps'), 1);
+    gl.bindVertexArray(gl.createVertexArray());
+    const levels = [];
+    for (const lv of fx.levels) {
+        texture(1, lv.count, 2, lv.taps.concat(lv.info));
+        gl.uniform1i(gl.getUniformLocation(program, 'u_count'), lv.count);
+        gl.uniform1f(gl.getUniformLocation(program, 'u_factor'), lv.factor);
+        gl.uniform1i(gl.getUniformLocation(program, 'u_n'), lv.n);
+        gl.activeTexture(gl.TEXTURE2); // the render target binds here, on no sampler's unit
+        const fb = gl.createFramebuffer(), tex = gl.createTexture();
+        gl.bindTexture(gl.TEXTURE_2D, tex);
+        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
+        gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+        gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+        gl.viewport(0, 0, lv.n, lv.n);
+        const rgb = [];
+        for (let f = 0; f < 6; ++f) {
+            gl.uniform1i(gl.getUniformLocation(program, 'u_face'), f);
+            gl.drawArrays(gl.TRIANGLES, 0, 3);
+            const out = new Float32Array(4 * lv.n * lv.n);
+            gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, out);
+            for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(out[4 * k], out[4 * k + 1], out[4 * k + 2]);
+        }
+        levels.push({ level: lv.level, n: lv.n, rgb });
+    }
+    await post({ kind: 'prefilter', levels, renderer: rendererName(gl) });
+}
+
 // ---- interactive viewer ----------------------------------------------------------------------------
 
 async function runViewer() {
@@ -575,6 +626,7 @@ async function main() {
     try {
         if (testMode === 'preview') await runPreviewTest();
         else if (testMode === 'numeric') await runNumericTest();
+        else if (testMode === 'prefilter') await runPrefilterTest();
         else await runViewer();
     } catch (e) {
         log(String(e.stack || e));

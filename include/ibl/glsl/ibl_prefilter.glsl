@@ -1,0 +1,95 @@
+// ibl/glsl/ibl_prefilter.glsl — the prefilter's convolution (bake/sphere_convolve.hpp's cubemap
+// fast path, batch/sphere_kernel.hpp) as a fragment shader: one pass per output face and level
+// renders that face's n x n texels into a float target, each the normalised sum of the level's
+// taps read bilinearly from the source. The taps are the C++ tables: the fast filter's
+// (bake/prefilter_fast.hpp) or filtered importance sampling's, split into single-level bilinear
+// taps (detail::make_taps), so a GPU re-filters a dynamic probe with the same filter the bake uses.
+//
+// Inputs (what tools/viewer/viewer.js uploads, from ibl::detail::pack_cube and make_taps):
+//   src   RGBA32F 2-D texture: the packed source (every level's faces with their 1-texel borders,
+//         detail::packed_cube), texel k of the packing at (k % width, k / width), read by texelFetch;
+//   taps  RGBA32F 2-D texture of `count` x 2 texels: row 0 the tap (x, y, z, w) (tangent-space
+//         direction, weight), row 1 its source level (n, n + 2, (n + 2)^2, offset of the level);
+//   factor  make_taps' scale / norm (norm: the weights summed in blocks of 32, as here).
+// Every operation is the C++ kernel's in the same order (the frame, the branch-free face selection,
+// the bordered bilinear address and weights, the blocks of 32 taps), so the result equals the
+// C++ within float rounding (the browser test: within half-float rounding on every level).
+// Differences from the C++: the frame's sign(n.z) (ibl_make_frame, ibl_runtime.glsl) differs at
+// n.z = -0 only, i.e. at texel centres on a face's middle column of odd face sizes.
+// Needs ibl_common.glsl, ibl_lookup.glsl, ibl_shade.glsl and ibl_runtime.glsl first.
+
+#ifndef IBL_GLSL_PREFILTER
+#define IBL_GLSL_PREFILTER 1
+#ifndef IBL_GLSL_RUNTIME
+#error "ibl_prefilter.glsl needs ibl_runtime.glsl first"
+#endif
+
+// Unit direction through the centre of texel (x, y) of face `face` of an n x n level
+// (env/cube_geometry.hpp cube_texel_direction).
+vec3 ibl_cube_texel_direction(int face, int x, int y, int n) {
+    float inv = 1.0 / float(n);
+    float sc = 2.0 * ((float(x) + 0.5) * inv) - 1.0, tc = 2.0 * ((float(y) + 0.5) * inv) - 1.0;
+    vec3 p = face == 0 ? vec3(1.0, -tc, -sc)
+           : face == 1 ? vec3(-1.0, -tc, sc)
+           : face == 2 ? vec3(sc, 1.0, tc)
+           : face == 3 ? vec3(sc, -1.0, -tc)
+           : face == 4 ? vec3(sc, -tc, 1.0)
+                       : vec3(-sc, -tc, -1.0);
+    return normalize(p);
+}
+
+// Face and (s, t) in [0, 1] of a direction: batch/sphere_kernel.hpp lane_cube_coord.
+void ibl_cube_face_st(vec3 d, out int face, out float s, out float t) {
+    vec3 a = abs(d);
+    bool xm = a.x >= a.y && a.x >= a.z;
+    bool ym = !xm && a.y >= a.z;
+    float ma = xm ? a.x : (ym ? a.y : a.z);
+    float major = xm ? d.x : (ym ? d.y : d.z);
+    bool neg = major < 0.0;
+    float sg = neg ? -1.0 : 1.0;
+    float sc = xm ? -sg * d.z : (ym ? d.x : sg * d.x);
+    float tc = ym ? sg * d.z : -d.y;
+    face = (xm ? 0 : (ym ? 2 : 4)) + (neg ? 1 : 0);
+    float half_inv = 0.5 / ma;
+    s = clamp(sc * half_inv + 0.5, 0.0, 1.0);
+    t = clamp(tc * half_inv + 0.5, 0.0, 1.0);
+}
+
+vec4 ibl_packed_texel(sampler2D src, int k) {
+    int w = textureSize(src, 0).x;
+    return texelFetch(src, ivec2(k % w, k / w), 0);
+}
+
+// The convolution of one output direction: factor * sum_i w_i B(src, level_i, F(dir) l_i).
+vec3 ibl_prefilter_texel(sampler2D src, sampler2D taps, int count, float factor, vec3 dir) {
+    ibl_frame fr = ibl_make_frame(dir);
+    vec4 total = vec4(0.0);
+    for (int b = 0; b < count; b += 32) {
+        vec4 block = vec4(0.0);
+        int e = min(b + 32, count);
+        for (int i = b; i < e; ++i) {
+            vec4 tap = texelFetch(taps, ivec2(i, 0), 0);
+            vec4 lv = texelFetch(taps, ivec2(i, 1), 0);
+            vec3 d = vec3(fr.t.x * tap.x + fr.b.x * tap.y + fr.n.x * tap.z,
+                          fr.t.y * tap.x + fr.b.y * tap.y + fr.n.y * tap.z,
+                          fr.t.z * tap.x + fr.b.z * tap.y + fr.n.z * tap.z);
+            int face;
+            float s, t;
+            ibl_cube_face_st(d, face, s, t);
+            int n = int(lv.x), st = int(lv.y), fs = int(lv.z), off = int(lv.w);
+            float fx = s * lv.x + 0.5, fy = t * lv.x + 0.5; // bordered coordinates in [0.5, n + 0.5]
+            int x0 = min(int(fx), n), y0 = min(int(fy), n);
+            float wx = fx - float(x0), wy = fy - float(y0);
+            int idx = off + face * fs + y0 * st + x0;
+            vec4 p0 = ibl_packed_texel(src, idx), p1 = ibl_packed_texel(src, idx + 1);
+            vec4 q0 = ibl_packed_texel(src, idx + st), q1 = ibl_packed_texel(src, idx + st + 1);
+            vec4 top = p0 + wx * (p1 - p0);
+            vec4 bot = q0 + wx * (q1 - q0);
+            block += tap.w * (top + wy * (bot - top));
+        }
+        total += block;
+    }
+    return total.rgb * factor;
+}
+
+#endif // IBL_GLSL_PREFILTER
