@@ -863,7 +863,7 @@ void print_prefilter_fixtures() {
     const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
     const ibl::detail::packed_cube packed = ibl::detail::pack_cube(src);
     const std::size_t texels = packed.data.size() / 4, height = (texels + width - 1) / width;
-    std::printf("{\"width\": %d, \"height\": %zu, \"packed\": [", width, height);
+    std::printf("{\"width\": %d, \"height\": %zu, \"size\": %d, \"packed\": [", width, height, size);
     for (std::size_t k = 0; k < width * height * 4; ++k)
         std::printf("%s%.9g", k ? ", " : "", k < packed.data.size() ? double(packed.data[k]) : 0.0);
     std::printf("], \"levels\": [");
@@ -877,8 +877,10 @@ void print_prefilter_fixtures() {
         table.trilinear = lp.trilinear;
         const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
         const int n = chain.size(int(l));
-        std::printf("%s{\"level\": %d, \"n\": %d, \"count\": %zu, \"factor\": %.9g, \"taps\": [", first ? "" : ", ",
-                    int(l), n, taps.w.size(), double(taps.factor));
+        std::printf("%s{\"level\": %d, \"n\": %d, \"roughness\": %.17g, \"samples\": %u, \"trilinear\": %s, \"weight\": \"%s\", "
+                    "\"count\": %zu, \"factor\": %.9g, \"taps\": [",
+                    first ? "" : ", ", int(l), n, lp.roughness, lp.samples, lp.trilinear ? "true" : "false",
+                    o.weight == ibl::ld_weight::g1 ? "g1" : "nl", taps.w.size(), double(taps.factor));
         first = false;
         for (std::size_t i = 0; i < taps.w.size(); ++i)
             std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]), double(taps.z[i]),

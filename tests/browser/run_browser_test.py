@@ -92,8 +92,9 @@ def read_png_rgb(path):
 # ---- the page's server ------------------------------------------------------------------------------
 
 class Server:
-    """Serves /tools/viewer/, /include/ibl/glsl/ from the repository and /bake/ from the bake folder;
-    a POST to /result stores the page's JSON."""
+    """Serves /tools/viewer/, /include/ibl/glsl/, /include/ibl/bake/ (the fast filter's shape table
+    the viewer re-filters with) from the repository and /bake/ from the bake folder; a POST to
+    /result stores the page's JSON."""
 
     def __init__(self, repo, bake_dir):
         self.result = None
@@ -101,6 +102,7 @@ class Server:
         outer = self
         roots = {"/tools/viewer/": os.path.join(repo, "tools", "viewer"),
                  "/include/ibl/glsl/": os.path.join(repo, "include", "ibl", "glsl"),
+                 "/include/ibl/bake/": os.path.join(repo, "include", "ibl", "bake"),
                  "/bake/": bake_dir}
 
         class Handler(http.server.BaseHTTPRequestHandler):
@@ -437,6 +439,20 @@ def compare_prefilter(fixtures, result):
         print(f"level {lv['level']} ({lv['n']}^2 x 6, {lv['count']} taps): worst |diff| / (2^-11 |C++|) {worst:.3g}, "
               f"{bad} values outside")
         ok = ok and bad == 0
+    # The viewer's live path (tools/viewer/refilter.js): its packing and taps against the C++ ones,
+    # and its render against the C++ chain (the taps' lods and weights agree to float rounding,
+    # so within 1e-4 relative).
+    print(f"viewer packing: max relative difference from ibl::detail::pack_cube {result['packed_max_rel']:.3g}")
+    ok = ok and result["packed_max_rel"] <= 1e-6
+    for lv, d in zip(fixtures["levels"], result["taps"]):
+        print(f"viewer taps, level {lv['level']}: {d}")
+        ok = ok and "max_abs" in d and d["max_abs"] <= 1e-5 and abs(d["factor"] - d["expected_factor"]) <= 1e-6 * abs(d["expected_factor"])
+    by_level = {lv["level"]: lv for lv in result["js_levels"]}
+    for lv in fixtures["levels"]:
+        got = by_level.get(lv["level"])
+        worst = max(abs(g - e) / max(abs(e), 1e-30) for e, g in zip(lv["expect"], got["rgb"])) if got else float("inf")
+        print(f"viewer re-filter, level {lv['level']}: worst relative difference from ibl::prefilter {worst:.3g}")
+        ok = ok and worst <= 1e-4
     print(f"renderer: {result.get('renderer')}")
     print("PASS" if ok else "FAIL")
     return ok

@@ -23,7 +23,8 @@
 // and the spheres are shaded by the two-tap model, ibl_lobe_taps2_sample); else by the split
 // sum.
 
-import { parseKtx2Cubemap, meanLuminance } from './ktx2.js';
+import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
+import { packSource, parseFastShapes, fastTaps } from './refilter.js';
 
 const params = new URLSearchParams(location.search);
 const testMode = params.get('test');
@@ -238,6 +239,55 @@ function uploadLut(gl, dfg, channelsLayout) {
     return { tex, format: floatLinear ? 'RGBA32F' : 'RGBA16F' };
 }
 
+/// An RGBA32F 2-D texture on texture unit `unit`, read by texelFetch (nearest).
+function floatTexture(gl, unit, w, h, values) {
+    const t = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE0 + unit);
+    gl.bindTexture(gl.TEXTURE_2D, t);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, w, h, 0, gl.RGBA, gl.FLOAT, values);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    return t;
+}
+
+/// The packed source (refilter.js packSource, or the C++ packing) as the RGBA32F texture
+/// ibl_prefilter.glsl reads on unit 0, `width` texels per row.
+function packedTexture(gl, data, width) {
+    const height = Math.ceil(data.length / 4 / width), all = new Float32Array(4 * width * height);
+    all.set(data);
+    return floatTexture(gl, 0, width, height, all);
+}
+
+/// The passes of ibl_prefilter.glsl, one per face of each level: the packed source bound on unit 0;
+/// per level { n, count, factor, taps, info } its taps uploaded on unit 1; target(level, face) binds
+/// the framebuffer's attachment before a pass, done(level, face) runs after it. Returns the tap
+/// textures it made (the caller deletes them).
+function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
+    const u = (name) => gl.getUniformLocation(program, name);
+    gl.useProgram(program);
+    gl.bindVertexArray(vao);
+    gl.uniform1i(u('u_src'), 0);
+    gl.uniform1i(u('u_taps'), 1);
+    const made = [];
+    for (const lv of levels) {
+        const both = new Float32Array(8 * lv.count);
+        both.set(lv.taps);
+        both.set(lv.info, 4 * lv.count);
+        made.push(floatTexture(gl, 1, lv.count, 2, both));
+        gl.uniform1i(u('u_count'), lv.count);
+        gl.uniform1f(u('u_factor'), lv.factor);
+        gl.uniform1i(u('u_n'), lv.n);
+        gl.viewport(0, 0, lv.n, lv.n);
+        for (let f = 0; f < 6; ++f) {
+            target(lv, f);
+            gl.uniform1i(u('u_face'), f);
+            gl.drawArrays(gl.TRIANGLES, 0, 3);
+            done(lv, f);
+        }
+    }
+    return made;
+}
+
 class Renderer {
     constructor(canvas, glsl, fragment) {
         const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true, alpha: false, premultipliedAlpha: false });
@@ -245,6 +295,7 @@ class Renderer {
         this.gl = gl;
         this.canvas = canvas;
         this.program = compile(gl, VERTEX, HEADER + glsl + '\n' + fragment);
+        this.glsl = glsl;
         this.vao = gl.createVertexArray();
         this.u = (name) => gl.getUniformLocation(this.program, name);
     }
@@ -282,6 +333,46 @@ class Renderer {
         // ibl-bake's preview_ss: 2 x 2 at --quality low, 4 x 4 otherwise.
         const quality = bake.report && bake.report.options && bake.report.options.quality;
         this.previewSs = quality === 'low' ? 2 : 4;
+    }
+
+    /// Re-filters the loaded chain's levels >= 1 from its level 0 on the GPU with the fast filter
+    /// (ibl_prefilter.glsl: refilter.js packs level 0 with its mips and builds each level's taps at
+    /// the level's roughness from report.json, 32 * 2^(v - 1) samples at virtual level v, trilinear
+    /// reads, the chain's LD weight) and renders every face of every level into the chain texture.
+    /// Returns { prepare_ms (packing and taps, CPU), gpu_ms (the passes, to gl.finish) }.
+    refilter(prefilterFragment, shapesText) {
+        const gl = this.gl, bake = this.bake, chain = bake.chain;
+        const spec = bake.report && bake.report.specular;
+        if (!spec || !Array.isArray(spec.levels)) throw new Error('re-filtering needs report.json (the levels\' roughness)');
+        if (chain.vkFormat !== 97 && chain.vkFormat !== 109) throw new Error('re-filtering needs an rgba16f or rgba32f chain (--ktx2-format)');
+        if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('re-filtering needs EXT_color_buffer_float');
+        if (!this.prefilterProgram) this.prefilterProgram = compile(gl, VERTEX, HEADER + this.glsl + '\n' + prefilterFragment);
+        const t0 = performance.now();
+        const l0 = chain.levels[0], n0 = l0.size, half = chain.vkFormat === 97;
+        const packed = packSource(n0, (f, x, y) => {
+            const a = l0.faces[f], i = 4 * (y * n0 + x);
+            return half ? [halfToFloat(a[i]), halfToFloat(a[i + 1]), halfToFloat(a[i + 2])] : [a[i], a[i + 1], a[i + 2]];
+        });
+        const shapes = parseFastShapes(shapesText);
+        const weight = spec.ld_weight === 'g1' ? 'g1' : 'nl';
+        const plan = [];
+        spec.levels.forEach((lv, k) => {
+            if (k === 0 || !(lv.virtual_level > 0) || k >= chain.levels.length) return;
+            const samples = Math.min(16384, 32 * 2 ** (lv.virtual_level - 1));
+            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed) });
+        });
+        const t1 = performance.now();
+        const srcTex = packedTexture(gl, packed.data, 4096);
+        const fb = gl.createFramebuffer();
+        gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+        const made = prefilterPasses(gl, this.prefilterProgram, this.vao, plan, (lv, f) =>
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k));
+        gl.finish();
+        const t2 = performance.now();
+        gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+        gl.deleteFramebuffer(fb);
+        for (const t of made.concat([srcTex])) gl.deleteTexture(t);
+        return { prepare_ms: t1 - t0, gpu_ms: t2 - t1, levels: plan.length };
     }
 
     /// Draws into the canvas at its current size. view: { mode, roughness, ev, lookup, multiscatter,
@@ -508,45 +599,55 @@ async function runPrefilterTest() {
     if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to render float results');
     const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('prefilter.frag.glsl')));
     const fx = JSON.parse(await fetchText(params.get('bake') + 'prefilter_fixtures.json'));
-    const texture = (unit, w, h, data) => {
-        const t = gl.createTexture();
-        gl.activeTexture(gl.TEXTURE0 + unit);
-        gl.bindTexture(gl.TEXTURE_2D, t);
-        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, w, h, 0, gl.RGBA, gl.FLOAT, new Float32Array(data));
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
-        gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
-        return t;
-    };
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
-    texture(0, fx.width, fx.height, fx.packed);
-    gl.useProgram(program);
-    gl.uniform1i(gl.getUniformLocation(program, 'u_src'), 0);
-    gl.uniform1i(gl.getUniformLocation(program, 'u_taps'), 1);
-    gl.bindVertexArray(gl.createVertexArray());
-    const levels = [];
-    for (const lv of fx.levels) {
-        texture(1, lv.count, 2, lv.taps.concat(lv.info));
-        gl.uniform1i(gl.getUniformLocation(program, 'u_count'), lv.count);
-        gl.uniform1f(gl.getUniformLocation(program, 'u_factor'), lv.factor);
-        gl.uniform1i(gl.getUniformLocation(program, 'u_n'), lv.n);
-        gl.activeTexture(gl.TEXTURE2); // the render target binds here, on no sampler's unit
-        const fb = gl.createFramebuffer(), tex = gl.createTexture();
-        gl.bindTexture(gl.TEXTURE_2D, tex);
-        gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
+    const vao = gl.createVertexArray();
+    // The viewer's own inputs (refilter.js) for the same source: the packing from level 0's
+    // interior and the taps from the level's roughness, samples and weight.
+    const n0 = fx.size, st0 = n0 + 2;
+    const js = packSource(n0, (f, x, y) => {
+        const k = 4 * (f * st0 * st0 + (y + 1) * st0 + (x + 1));
+        return [fx.packed[k], fx.packed[k + 1], fx.packed[k + 2]];
+    });
+    let packedDiff = 0;
+    for (let k = 0; k < js.data.length; ++k)
+        if (k % 4 !== 3) packedDiff = Math.max(packedDiff, Math.abs(js.data[k] - fx.packed[k]) / Math.max(1e-30, Math.abs(fx.packed[k])));
+    const shapes = parseFastShapes(await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
+    const jsTaps = fx.levels.map((lv) => fastTaps(shapes, lv.roughness, lv.samples, lv.weight, lv.trilinear, js));
+    const tapsDiff = fx.levels.map((lv, i) => {
+        const t = jsTaps[i];
+        if (t.count !== lv.count) return { count: t.count, expected: lv.count };
+        let d = 0;
+        for (let k = 0; k < 4 * lv.count; ++k) d = Math.max(d, Math.abs(t.taps[k] - lv.taps[k]), Math.abs(t.info[k] - lv.info[k]));
+        return { max_abs: d, factor: t.factor, expected_factor: lv.factor };
+    });
+    // Each level into an RGBA32F target, read back face by face (rows from y = 0: the chain's order).
+    const render = (levels) => {
+        const out = [];
+        const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-        gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
-        gl.viewport(0, 0, lv.n, lv.n);
-        const rgb = [];
-        for (let f = 0; f < 6; ++f) {
-            gl.uniform1i(gl.getUniformLocation(program, 'u_face'), f);
-            gl.drawArrays(gl.TRIANGLES, 0, 3);
-            const out = new Float32Array(4 * lv.n * lv.n);
-            gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, out);
-            for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(out[4 * k], out[4 * k + 1], out[4 * k + 2]);
-        }
-        levels.push({ level: lv.level, n: lv.n, rgb });
-    }
-    await post({ kind: 'prefilter', levels, renderer: rendererName(gl) });
+        let tex = null, rgb = null;
+        prefilterPasses(gl, program, vao, levels, (lv, f) => {
+            if (f !== 0) return;
+            gl.activeTexture(gl.TEXTURE2); // the render target binds here, on no sampler's unit
+            tex = gl.createTexture();
+            gl.bindTexture(gl.TEXTURE_2D, tex);
+            gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+            rgb = [];
+        }, (lv, f) => {
+            const px = new Float32Array(4 * lv.n * lv.n);
+            gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
+            for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(px[4 * k], px[4 * k + 1], px[4 * k + 2]);
+            if (f === 5) out.push({ level: lv.level, n: lv.n, rgb });
+        });
+        return out;
+    };
+    packedTexture(gl, Float32Array.from(fx.packed), fx.width);
+    const levels = render(fx.levels);
+    // The whole live path: the viewer's packing and taps through the same shader.
+    packedTexture(gl, js.data, fx.width);
+    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, n: lv.n, ...jsTaps[i] })));
+    await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff, taps: tapsDiff, renderer: rendererName(gl) });
 }
 
 // ---- interactive viewer ----------------------------------------------------------------------------
@@ -617,7 +718,19 @@ async function runViewer() {
         }
     };
     el('folder').addEventListener('change', (e) => open(fileSource(e.target.files)));
+    const refilter = async () => {
+        if (!ready) return;
+        try {
+            const t = renderer.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
+            el('refilter_v').textContent = `${t.levels} levels: ${t.gpu_ms.toFixed(1)} ms GPU + ${t.prepare_ms.toFixed(1)} ms CPU`;
+            redraw();
+        } catch (e) {
+            log(String(e.message || e));
+        }
+    };
+    el('refilter').addEventListener('click', refilter);
     if (params.get('bake')) await open(urlSource(params.get('bake')));
+    if (params.get('refilter') === '1') await refilter(); // ?refilter=1: re-filter once the bake is loaded
     else log('choose a bake folder (ibl-bake --out DIR), or open this page with ?bake=URL');
 }
 
