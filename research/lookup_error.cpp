@@ -10,6 +10,10 @@
 //   lookup_error spec       specular chains (level count, spacing, base size) x lookup schemes on
 //                           the built-in sky + sun and tests/data/{courtyard,studio}.exr
 //   lookup_error spec-quick the tool's chain only (256, 6 levels) and the chosen scheme
+//   lookup_error spec-fast  the chains of `spec` filtered by the fast filter (bake/prefilter_fast.hpp,
+//                           128 samples at level 1 doubled per level: ibl-bake --prefilter fast
+//                           --quality high) with their bake time, two schemes (the spacing study:
+//                           more levels cost the fast filter little, so what do they buy?)
 //
 // Specular: each environment is baked to a 512^2 source cube (full exact-box mip chain); each chain
 // is ibl::prefilter of that cube as ibl-bake does at its default quality (filtered importance
@@ -122,13 +126,17 @@ std::vector<std::uint32_t> tool_samples(int levels) {
     return s;
 }
 
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const chain_config& c) {
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const chain_config& c, bool fast = false) {
     ibl::prefilter_options o;
     o.levels = c.levels;
     o.base_size = c.base;
     o.policy = ibl::roughness_mip_policy{c.mapping};
     o.trilinear = true;
     o.samples_per_level = tool_samples(c.levels);
+    if (fast) { // 128 at level 1 doubled per level: the fast filter at ibl-bake's --quality high
+        o.method = ibl::prefilter_method::fast;
+        for (std::uint32_t& n : o.samples_per_level) n /= 4;
+    }
     return ibl::prefilter(src, o, ibl::thread_executor{});
 }
 
@@ -179,7 +187,7 @@ double chain_bytes_half(const ibl::cubemap<float>& c) {
     return b;
 }
 
-void run_spec(bool quick) {
+void run_spec(bool quick, bool fast = false) {
     std::vector<environment_case> envs;
     envs.reserve(3);
     const auto t0 = std::chrono::steady_clock::now();
@@ -263,20 +271,18 @@ void run_spec(bool quick) {
         {"catmull-rom lod", {ibl::roughness_mapping::linear, ibl::level_weight::lod, 1.0, ibl::level_interpolation::catmull_rom}},
         {"catmull-rom log r", {ibl::roughness_mapping::linear, ibl::level_weight::log, 1.0, ibl::level_interpolation::catmull_rom}},
     };
-    if (quick) {
-        chains.resize(1);
-        schemes = {schemes[0], schemes[3]};
-    }
+    if (quick) chains.resize(1);
+    if (quick || fast) schemes = {schemes[0], schemes[3]};
 
     std::printf("\n== specular lookup: worst relative RMSE of luminance over r = 0.25..1 (total / interpolation only / levels only)\n");
-    std::printf("| environment | chain | taps | scheme | total | at r | interpolation | levels | total, f16 chain | MB (f16) |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|\n");
+    std::printf("| environment | chain | taps | scheme | total | at r | interpolation | levels | total, f16 chain | MB (f16) | bake s |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
     std::vector<std::string> details;
     for (std::size_t ei = 0; ei < envs.size(); ++ei) {
         const environment_case& e = envs[ei];
         for (const auto& cc : chains) {
             const auto tb = std::chrono::steady_clock::now();
-            const ibl::cubemap<float> chain = bake_chain(e.source, cc);
+            const ibl::cubemap<float> chain = bake_chain(e.source, cc, fast);
             const ibl::cubemap<float> chain_h = ibl::quantize_half(chain);
             const double bake_s = seconds_since(tb);
             for (const auto& s : schemes) {
@@ -285,9 +291,9 @@ void run_spec(bool quick) {
                 const auto rep = ibl::specular_lookup_error(chain, d, rs, dirs[ei], envs[ei].cached());
                 const auto rep_h = ibl::specular_lookup_error(chain_h, d, rs, dirs[ei], envs[ei].cached());
                 const worst w = summarise(rep), wh = summarise(rep_h);
-                std::printf("| %s | %s | %d | %s | %.4f | %.2f | %.4f | %.4f | %.4f | %.2f |\n", e.name.c_str(), cc.name,
+                std::printf("| %s | %s | %d | %s | %.4f | %.2f | %.4f | %.4f | %.4f | %.2f | %.2f |\n", e.name.c_str(), cc.name,
                             d.interpolation == ibl::level_interpolation::catmull_rom ? 4 : 2, s.name, w.total, w.r_total,
-                            w.interp, w.levels, wh.total, chain_bytes_half(chain) / 1048576.0);
+                            w.interp, w.levels, wh.total, chain_bytes_half(chain) / 1048576.0, bake_s);
                 std::fflush(stdout);
                 if (&cc == &chains[0] && (&s == &schemes[0] || std::strcmp(s.name, "log r, geometric") == 0)) {
                     std::string t = "\n" + e.name + ", " + cc.name + ", " + s.name + ":\n| r | total | interpolation | levels | max overshoot |\n|---|---|---|---|---|\n";
@@ -315,5 +321,6 @@ int main(int argc, char** argv) {
     const std::string mode = argc > 1 ? argv[1] : "all";
     if (mode == "all" || mode == "dfg") run_dfg();
     if (mode == "all" || mode == "spec" || mode == "spec-quick") run_spec(mode == "spec-quick");
+    if (mode == "spec-fast") run_spec(false, true);
     return 0;
 }

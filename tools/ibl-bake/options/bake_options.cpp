@@ -126,13 +126,15 @@ std::string path_value(const std::string& option, const std::string& v) {
 /// default = the textbook products (what every renderer that implements Karis's split sum reads:
 /// n.l chain read by textureLod at lod(r), uniform (n.v, r) DFG table, nothing taken out of the
 /// environment); accurate = the more accurate conventions (G1 chain, remapped DFG table, the
-/// fitted lobe LUT, a compact sun taken out as a disk light, the log-geometric chain lookup).
+/// fitted lobe LUT, a compact sun taken out as a disk light, the log-geometric chain lookup on
+/// levels spaced as lod = (V - 1) r (2 - r): denser at low roughness, the best spacing of the
+/// same levels and storage measured, docs/lookup.md).
 void apply_preset(bake_options& o, bake_preset p) {
     o.preset = p;
     const bool accurate = p == bake_preset::accurate;
     const bool filament = p == bake_preset::filament;
     const bool engine = filament || p == bake_preset::gltf;
-    o.policy = filament ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
+    o.policy = filament || accurate ? ibl::roughness_mip_policy::filament() : ibl::roughness_mip_policy::linear();
     o.specular_lookup = accurate ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
     o.dfg_layout = accurate ? ibl::dfg_lut_layout::remapped() : ibl::dfg_lut_layout::uniform();
     o.dfg_channels = filament ? dfg_channel_order::filament : dfg_channel_order::ab;

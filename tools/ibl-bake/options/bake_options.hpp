@@ -28,7 +28,7 @@
 //                       compact dominant source as a disk light, lights.json) | on
 //   --preset P          default (the textbook products) | accurate | filament | gltf: a set of
 //                       conventions (docs/ibl-bake.md); options after it override what it sets
-//   --policy P          linear (default) | filament: the roughness <-> lod mapping of the chain
+//   --policy P          linear (default) | filament (--preset accurate, filament): the roughness <-> lod mapping of the chain
 //   --mirror            mirror the environment (x -> -x), as Filament's cmgen does by default
 //   --sheen             also the sheen products (Charlie chain sheen_*.exr / sheen.ktx2, sheen_lut.exr)
 //   --dfg-layout L      uniform (default: texel centres in (n.v, r)) | remapped (cbrt(n.v) x sqrt(r),

@@ -53,6 +53,14 @@ namespace {
 
 const std::string tool = IBL_BAKE_TOOL;
 
+/// The chain lookup of --preset accurate: log-geometric on its levels spaced lod = (V - 1) r (2 - r)
+/// (a chain read from a file carries no mapping: the reader states it, as a renderer does).
+ibl::specular_lookup_desc accurate_preset_lookup() {
+    ibl::specular_lookup_desc d = ibl::specular_lookup_desc::accurate();
+    d.mapping = ibl::roughness_mapping::filament;
+    return d;
+}
+
 ibl::cubemap<float> load_chain(const std::string& path) {
     const std::string b = slurp(path);
     return cubemap_from_rgb32f(
@@ -89,7 +97,7 @@ ibl::lobe_lut load_lobe(const std::string& path) {
 /// tool forms it: R in double, the directions in float, each chain read by the accurate lookup.
 dvec3 lobe_pair_ld(const ibl::cubemap<float>& chain, const ibl::lobe_lut& lobe, const ibl::lobe_lut& lobe_b, const dvec3& n,
                    const dvec3& v, double r, const dvec3& f0, const dvec3& f90) {
-    const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
+    const ibl::specular_lookup_desc sd = accurate_preset_lookup();
     const double ndv = std::clamp(glm::dot(n, v), 0.0, 1.0);
     const dvec3 r_dir = 2.0 * glm::dot(n, v) * n - v;
     const ibl::vec4<float> pa = ibl::lobe_lut_lookup(lobe, float(ndv), float(r));
@@ -129,7 +137,7 @@ std::vector<double> taps_read(const ibl::lobe_taps_lut& t, double n_dot_v, doubl
 dvec3 taps_ld(const ibl::cubemap<float>& chain, const ibl::lobe_taps_lut& t, const dvec3& n, const dvec3& v, double r) {
     const fvec3 fn(n), fv(v);
     const std::vector<double> p = taps_read(t, ibl::saturate(glm::dot(fn, fv)), r);
-    const fvec3 e = ibl::specular_lobe_taps(chain, ibl::specular_lookup_desc::accurate(), t, fn, fv, float(r),
+    const fvec3 e = ibl::specular_lobe_taps(chain, accurate_preset_lookup(), t, fn, fv, float(r),
                                             fvec3(1.0f), fvec3(1.0f));
     return dvec3(e) / double(ibl::saturate(float(p[0])) + ibl::saturate(float(p[1])));
 }
@@ -185,7 +193,7 @@ TEST_CASE("lookup: answers equal the library's runtime functions on the bake's f
     const ibl::sh_coeffs<double, 3> shc = load_sh(s / "bake/sh.json");
     const ibl::lobe_lut lobe = load_lobe(s / "bake/lobe_lut.exr"); // the accurate preset's runtime model
     const ibl::lobe_lut lobe_b = load_lobe(s / "bake/lobe_lut_b.exr"); // its B part
-    const ibl::specular_lookup_desc sd = ibl::specular_lookup_desc::accurate();
+    const ibl::specular_lookup_desc sd = accurate_preset_lookup();
 
     std::vector<std::string> q;
     std::vector<std::vector<double>> want;
@@ -357,7 +365,7 @@ TEST_CASE("lookup: with the accurate bake (irradiance map, extracted sun) answer
             std::snprintf(buf, sizeof buf, "specular %.17g %.17g %.17g %.17g\nirradiance %.17g %.17g %.17g\n", d.x, d.y, d.z, r, d.x, d.y, d.z);
             q += buf;
             // the chain is G1-weighted: the sun's term of the same weight (the tool's 8 nodes)
-            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r), ibl::specular_lookup_desc::accurate())) +
+            const dvec3 ld = dvec3(ibl::specular_lookup(chain, fvec3(d), float(r), accurate_preset_lookup())) +
                              ibl::disk_light_ld(sun, d, r, 8, ibl::ld_weight::g1);
             const dvec3 e = dvec3(map.radiance(fvec3(d), 0.0f)) + ibl::disk_light_irradiance(d, sun);
             want.push_back({ld.x, ld.y, ld.z});
