@@ -2,6 +2,7 @@
 // ibl/bake.hpp — the bake layer: the producers of the products a renderer reads (prefiltered chain,
 // irradiance, DFG / sheen / lobe / occlusion tables) and the scene-driven bake plan. It includes the
 // runtime layer (the structs and conventions it produces), never a reference (tests/header_deps.cmake).
+#include "bake/bc6h.hpp" // BC6H_UFLOAT block compression of the HDR products (decoder and encoder)
 #include "bake/dfg.hpp"
 #include "bake/dfg_export.hpp"
 #include "bake/dfg_lut.hpp"
