@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # Installs (as root, with apt-get) the Debian packages a job needs, skipping those already present.
 #   bash scripts/deps.sh bake   what the main job needs: build and run ibl-bake (compiler, CMake,
-#                               Ninja, GLM, stb, OpenEXR)
+#                               Ninja, GLM, stb, OpenEXR, astc-encoder, Zstandard)
 #   bash scripts/deps.sh        everything the tests, benchmarks and tools need (the test command):
 #                               also clang, doctest, Google Benchmark, matplotlib, glslang, chromium
 set -euo pipefail
-bake=(cmake ninja-build g++ libglm-dev libstb-dev libopenexr-dev)
+bake=(cmake ninja-build g++ libglm-dev libstb-dev libopenexr-dev libastcenc-dev libzstd-dev)
 all=("${bake[@]}" clang libclang-rt-14-dev doctest-dev libbenchmark-dev python3-matplotlib glslang-tools chromium)
 case "${1:-all}" in
     bake) pkgs=("${bake[@]}") ;;

@@ -21,6 +21,8 @@
 #include "io/image_io.hpp"
 #include "io/ktx2.hpp"
 
+#include <utility>
+
 namespace {
 
 constexpr int W = 16, H = 8;
@@ -144,5 +146,18 @@ int main(int argc, char** argv) {
     ibl_bake::write_png(dir + "/seed_ldr.png", test_image(4, 2));
     ibl_bake::write_ktx2_cubemap(dir + "/seed_cube.ktx2", ibl_bake::cubemap_rgb32f::zeros(2, 2),
                                  ibl_bake::ktx2_format::rgba16f);
+    // the block formats and Zstandard supercompression (a 8^2 cube of varied values, 4 levels)
+    ibl_bake::cubemap_rgb32f cube = ibl_bake::cubemap_rgb32f::zeros(8, 4);
+    for (auto& level : cube.levels)
+        for (auto& face : level)
+            for (std::size_t i = 0; i < face.size(); ++i) face[i] = float(0.01 * double(i % 37) * double(1 + i % 5));
+    const std::pair<const char*, ibl_bake::ktx2_format> blocks[] = {
+        {"bc6h", ibl_bake::ktx2_format::bc6h}, {"astc4x4", ibl_bake::ktx2_format::astc4x4}, {"astc6x6", ibl_bake::ktx2_format::astc6x6}};
+    for (const auto& [name, format] : blocks) {
+        ibl_bake::write_ktx2_cubemap(dir + "/seed_" + name + ".ktx2", cube, format, "seed", {}, {ibl_bake::block_quality::fast, 0, 1});
+        ibl_bake::write_ktx2_cubemap(dir + "/seed_" + name + "_zstd.ktx2", cube, format, "seed", {}, {ibl_bake::block_quality::fast, 3, 1});
+    }
+    ibl_bake::write_ktx2_cubemap(dir + "/seed_rgba16f_zstd.ktx2", cube, ibl_bake::ktx2_format::rgba16f, "seed", {},
+                                 {ibl_bake::block_quality::fast, 3, 1});
     return 0;
 }

@@ -7,8 +7,12 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <memory>
 #include <string_view>
 
+#include <zstd.h>
+
+#include "io/block_codec.hpp"
 #include "io/image_io.hpp"
 
 namespace ibl_bake {
@@ -17,7 +21,10 @@ namespace {
 constexpr unsigned char ktx2_identifier[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
 constexpr std::size_t header_bytes = 80;
 constexpr std::size_t level_entry_bytes = 24;
-constexpr std::uint32_t khr_df_model_rgbsda = 1, khr_df_primaries_bt709 = 1, khr_df_transfer_linear = 1;
+constexpr std::uint32_t khr_df_model_rgbsda = 1, khr_df_model_bc6h = 131, khr_df_model_astc = 162;
+constexpr std::uint32_t khr_df_primaries_bt709 = 1, khr_df_transfer_linear = 1;
+constexpr std::uint32_t ktx2_ss_zstd = 2;
+constexpr std::uint64_t max_inflated_bytes = std::uint64_t(1) << 31; ///< what the reader inflates at most
 constexpr std::uint32_t khr_df_version_1_3 = 2;
 constexpr std::uint32_t khr_df_float = 0x80, khr_df_signed = 0x40, khr_df_exponent = 0x20;
 constexpr std::uint32_t float_minus_one_bits = 0xBF800000u, float_one_bits = 0x3F800000u;
@@ -44,6 +51,9 @@ std::vector<dfd_sample> dfd_samples(ktx2_format f) {
                 {2 | khr_df_float, 22, 10, 0, float_one_bits}};
     case ktx2_format::e5b9g9r9:
         break;
+    case ktx2_format::bc6h: return {{0 | khr_df_float, 0, 128, 0, float_one_bits}};
+    case ktx2_format::astc4x4:
+    case ktx2_format::astc6x6: return {{0 | khr_df_float | khr_df_signed, 0, 128, float_minus_one_bits, float_one_bits}};
     }
     std::vector<dfd_sample> v;
     for (std::uint32_t c = 0; c < 3; ++c) {
@@ -57,7 +67,19 @@ std::uint32_t dfd_total_bytes(ktx2_format f) { return std::uint32_t(4 + 24 + 16 
 
 bool known_format(std::uint32_t vk) {
     return vk == std::uint32_t(ktx2_format::rgba32f) || vk == std::uint32_t(ktx2_format::rgba16f) ||
-           vk == std::uint32_t(ktx2_format::b10g11r11) || vk == std::uint32_t(ktx2_format::e5b9g9r9);
+           vk == std::uint32_t(ktx2_format::b10g11r11) || vk == std::uint32_t(ktx2_format::e5b9g9r9) ||
+           vk == std::uint32_t(ktx2_format::bc6h) || vk == std::uint32_t(ktx2_format::astc4x4) ||
+           vk == std::uint32_t(ktx2_format::astc6x6);
+}
+
+/// typeSize of the header: 2 for RGBA16F, 1 for the block formats, 4 otherwise.
+std::uint32_t type_size(ktx2_format f) {
+    return f == ktx2_format::rgba16f ? 2 : ktx2_block_compressed(f) ? 1 : 4;
+}
+
+/// Bytes of one level (6 faces of s x s texels) in `format`, before supercompression.
+std::size_t level_bytes(ktx2_format f, std::size_t s) {
+    return ktx2_block_compressed(f) ? 6 * block_image_bytes(f, int(s)) : 6 * s * s * ktx2_texel_bytes(f);
 }
 
 int full_chain(int n) {
@@ -110,6 +132,9 @@ std::size_t ktx2_texel_bytes(ktx2_format f) noexcept {
     switch (f) {
     case ktx2_format::rgba32f: return 16;
     case ktx2_format::rgba16f: return 8;
+    case ktx2_format::bc6h:
+    case ktx2_format::astc4x4:
+    case ktx2_format::astc6x6: return 16;
     default: return 4;
     }
 }
@@ -119,11 +144,12 @@ float ktx2_channel_max(ktx2_format f, int channel) noexcept {
     case ktx2_format::rgba32f: return std::numeric_limits<float>::max();
     case ktx2_format::rgba16f: return 65504.0f;
     case ktx2_format::b10g11r11: return channel == 2 ? 64512.0f : 65024.0f;
-    default: return 65408.0f;
+    case ktx2_format::e5b9g9r9: return 65408.0f;
+    default: return 65504.0f; // the block formats decode to half floats
     }
 }
 
-bool ktx2_unsigned(ktx2_format f) noexcept { return f == ktx2_format::b10g11r11 || f == ktx2_format::e5b9g9r9; }
+bool ktx2_unsigned(ktx2_format f) noexcept { return f != ktx2_format::rgba32f && f != ktx2_format::rgba16f; }
 
 namespace {
 void count_clamps(ktx2_format f, const float* px, ktx2_clamp_counts& k) noexcept {
@@ -266,6 +292,15 @@ void ktx2_roundtrip_texel(ktx2_format f, const float in[3], float out[3]) noexce
         return;
     case ktx2_format::b10g11r11: unpack_b10g11r11(pack_b10g11r11(in[0], in[1], in[2]), out); return;
     case ktx2_format::e5b9g9r9: unpack_e5b9g9r9(pack_e5b9g9r9(in[0], in[1], in[2]), out); return;
+    default: { // a block format: the texel as a constant block
+        const float block[3] = {in[0], in[1], in[2]};
+        std::vector<float> img(std::size_t(3 * ktx2_block_dim(f) * ktx2_block_dim(f)));
+        for (std::size_t i = 0; i < img.size(); ++i) img[i] = block[i % 3];
+        const std::vector<unsigned char> b = encode_block_image(f, img.data(), ktx2_block_dim(f), block_quality::normal);
+        const std::vector<float> d = decode_block_image(f, b.data(), b.size(), ktx2_block_dim(f));
+        for (int c = 0; c < 3; ++c) out[c] = d[std::size_t(c)];
+        return;
+    }
     }
 }
 
@@ -299,6 +334,7 @@ void put_texel(std::vector<unsigned char>& b, std::size_t at, ktx2_format format
         break;
     case ktx2_format::b10g11r11: put32(b, at, pack_b10g11r11(px[0], px[1], px[2])); break;
     case ktx2_format::e5b9g9r9: put32(b, at, pack_e5b9g9r9(px[0], px[1], px[2])); break;
+    default: break; // the block formats are written a whole image at a time (level_texels)
     }
 }
 
@@ -309,8 +345,12 @@ void put_dfd(std::vector<unsigned char>& b, std::size_t d, ktx2_format format, s
     put32(b, d, dfd_total);
     put32(b, d + 4, 0); // vendorId 0 (Khronos), descriptorType 0 (basic)
     put32(b, d + 8, khr_df_version_1_3 | (block_bytes << 16));
-    put32(b, d + 12, khr_df_model_rgbsda | (khr_df_primaries_bt709 << 8) | (khr_df_transfer_linear << 16));
-    put32(b, d + 16, 0);                  // texelBlockDimension0..3 = 0 (1 texel)
+    const std::uint32_t model = format == ktx2_format::bc6h ? khr_df_model_bc6h
+                                : ktx2_block_compressed(format) ? khr_df_model_astc
+                                                                : khr_df_model_rgbsda;
+    put32(b, d + 12, model | (khr_df_primaries_bt709 << 8) | (khr_df_transfer_linear << 16));
+    const std::uint32_t bd = std::uint32_t(ktx2_block_dim(format) - 1);
+    put32(b, d + 16, bd | (bd << 8));     // texelBlockDimension0..3 (0: 1 texel)
     put32(b, d + 20, std::uint32_t(tb));  // bytesPlane0
     put32(b, d + 24, 0);                  // bytesPlane4..7
     for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -350,18 +390,20 @@ void put_key_values(std::vector<unsigned char>& b, std::size_t at_kv, const std:
     }
 }
 
-/// Where the parts of a KTX2 file lie: the DFD, the key/value data, each level's texels (the
+/// Where the parts of a KTX2 file lie: the DFD, the key/value data, each level's bytes (the
 /// smallest level first in the file), and the file's size.
 struct ktx2_placement {
     std::uint32_t dfd_total = 0;
     std::size_t dfd_offset = 0, kvd_offset = 0, kvd_length = 0, size = 0;
-    std::vector<std::size_t> offset, length;
+    std::vector<std::size_t> offset, length, raw_length;
 };
 
-ktx2_placement place_ktx2(const cubemap_rgb32f& cube, ktx2_format format, std::size_t kvd_length) {
+/// levels[l]: the bytes of level l as stored (deflated when supercompressed); raw[l] its size inflated.
+ktx2_placement place_ktx2(ktx2_format format, std::size_t kvd_length, const std::vector<std::vector<unsigned char>>& levels,
+                          const std::vector<std::size_t>& raw, bool supercompressed) {
     ktx2_placement p;
-    const std::size_t L = cube.levels.size();
-    const std::size_t tb = texel_bytes(format);
+    const std::size_t L = levels.size();
+    const std::size_t align = supercompressed ? 1 : texel_bytes(format); // lcm(texel or block size, 4) = that size
     p.dfd_total = dfd_total_bytes(format);
     p.dfd_offset = header_bytes + level_entry_bytes * L;
     p.kvd_offset = p.dfd_offset + p.dfd_total;
@@ -369,11 +411,11 @@ ktx2_placement place_ktx2(const cubemap_rgb32f& cube, ktx2_format format, std::s
     std::size_t pos = p.kvd_offset + kvd_length;
     p.offset.resize(L);
     p.length.resize(L);
+    p.raw_length = raw;
     for (std::size_t i = L; i-- > 0;) {
-        const std::size_t s = std::size_t(cube.face_size(int(i)));
-        pos = align_up(pos, tb); // lcm(texel size, 4) = texel size for 4, 8 and 16
+        pos = align_up(pos, align);
         p.offset[i] = pos;
-        p.length[i] = 6 * s * s * tb;
+        p.length[i] = levels[i].size();
         pos += p.length[i];
     }
     p.size = pos;
@@ -381,18 +423,19 @@ ktx2_placement place_ktx2(const cubemap_rgb32f& cube, ktx2_format format, std::s
 }
 
 /// The identifier, the header and the level index.
-void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p) {
-    const std::size_t L = cube.levels.size();
+void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p,
+                     bool supercompressed) {
+    const std::size_t L = p.offset.size();
     std::memcpy(b.data(), ktx2_identifier, sizeof ktx2_identifier);
     put32(b, 12, std::uint32_t(format));
-    put32(b, 16, format == ktx2_format::rgba16f ? 2 : 4);
+    put32(b, 16, type_size(format));
     put32(b, 20, std::uint32_t(cube.size));
     put32(b, 24, std::uint32_t(cube.size));
     put32(b, 28, 0); // pixelDepth
     put32(b, 32, 0); // layerCount
     put32(b, 36, 6); // faceCount
     put32(b, 40, std::uint32_t(L));
-    put32(b, 44, 0); // supercompressionScheme
+    put32(b, 44, supercompressed ? ktx2_ss_zstd : 0);
     put32(b, 48, std::uint32_t(p.dfd_offset));
     put32(b, 52, p.dfd_total);
     put32(b, 56, std::uint32_t(p.kvd_offset));
@@ -403,53 +446,83 @@ void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, 
         const std::size_t at = header_bytes + level_entry_bytes * l;
         put64(b, at, p.offset[l]);
         put64(b, at + 8, p.length[l]);
-        put64(b, at + 16, p.length[l]);
+        put64(b, at + 16, p.raw_length[l]);
     }
 }
 
-/// Every level's texels in `format`; what the format clamped.
-ktx2_clamp_counts put_ktx2_texels(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p) {
-    const std::size_t tb = texel_bytes(format);
-    ktx2_clamp_counts seen;
-    for (std::size_t l = 0; l < cube.levels.size(); ++l) {
-        const std::size_t s = std::size_t(cube.face_size(int(l)));
-        std::size_t at = p.offset[l];
+/// Level l's bytes in `format` (6 faces in order); adds what the format clamped to `seen`.
+std::vector<unsigned char> level_texels(const cubemap_rgb32f& cube, std::size_t l, ktx2_format format, const ktx2_encoding& enc,
+                                        ktx2_clamp_counts& seen) {
+    const std::size_t s = std::size_t(cube.face_size(int(l)));
+    std::vector<unsigned char> b(level_bytes(format, s), 0);
+    for (const std::vector<float>& face : cube.levels[l])
+        for (std::size_t t = 0; t < s * s; ++t) count_clamps(format, face.data() + 3 * t, seen);
+    if (ktx2_block_compressed(format)) {
+        const std::size_t fb = block_image_bytes(format, int(s));
         for (std::size_t f = 0; f < 6; ++f) {
-            const std::vector<float>& src = cube.levels[l][f];
-            for (std::size_t t = 0; t < s * s; ++t) {
-                const float* px = src.data() + 3 * t;
-                count_clamps(format, px, seen);
-                put_texel(b, at, format, px);
-                at += tb;
-            }
+            const std::vector<unsigned char> blocks = encode_block_image(format, cube.levels[l][f].data(), int(s), enc.quality, enc.threads);
+            std::memcpy(b.data() + f * fb, blocks.data(), fb);
         }
+        return b;
     }
-    return seen;
+    const std::size_t tb = texel_bytes(format);
+    std::size_t at = 0;
+    for (std::size_t f = 0; f < 6; ++f)
+        for (std::size_t t = 0; t < s * s; ++t, at += tb) put_texel(b, at, format, cube.levels[l][f].data() + 3 * t);
+    return b;
+}
+
+std::vector<unsigned char> zstd_deflate(const std::vector<unsigned char>& raw, int level, const std::string& name) {
+    // One frame with its content size (the reader checks it against the level) and a checksum (a
+    // damaged level is refused instead of inflating to wrong blocks).
+    std::vector<unsigned char> out(ZSTD_compressBound(raw.size()));
+    const std::unique_ptr<ZSTD_CCtx, std::size_t (*)(ZSTD_CCtx*)> cctx(ZSTD_createCCtx(), ZSTD_freeCCtx);
+    if (!cctx) throw image_error(name, "Zstandard: out of memory");
+    ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_compressionLevel, level);
+    ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_checksumFlag, 1);
+    ZSTD_CCtx_setParameter(cctx.get(), ZSTD_c_contentSizeFlag, 1);
+    const std::size_t n = ZSTD_compress2(cctx.get(), out.data(), out.size(), raw.data(), raw.size());
+    if (ZSTD_isError(n)) throw image_error(name, std::string("Zstandard compression failed: ") + ZSTD_getErrorName(n));
+    out.resize(n);
+    return out;
 }
 
 } // namespace
 
 std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
                                                const std::string& name, ktx2_clamp_counts* counts,
-                                               const std::vector<std::pair<std::string, std::string>>& metadata) {
+                                               const std::vector<std::pair<std::string, std::string>>& metadata,
+                                               const ktx2_encoding& encoding) {
     check_cube(cube, name);
     if (!known_format(std::uint32_t(format)))
         throw image_error(name, "unsupported KTX2 format " + std::to_string(std::uint32_t(format)));
+    if (encoding.zstd_level < 0 || encoding.zstd_level > ZSTD_maxCLevel())
+        throw image_error(name, "Zstandard level " + std::to_string(encoding.zstd_level) + " outside 0.." + std::to_string(ZSTD_maxCLevel()));
     std::size_t kvd_length = 0;
     const std::vector<std::pair<std::string, std::string>> kv = ktx2_key_values(writer, name, metadata, kvd_length);
-    const ktx2_placement p = place_ktx2(cube, format, kvd_length);
+    const bool zstd = encoding.zstd_level > 0;
+    ktx2_clamp_counts seen;
+    std::vector<std::vector<unsigned char>> levels(cube.levels.size());
+    std::vector<std::size_t> raw(cube.levels.size());
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+        levels[l] = level_texels(cube, l, format, encoding, seen);
+        raw[l] = levels[l].size();
+        if (zstd) levels[l] = zstd_deflate(levels[l], encoding.zstd_level, name);
+    }
+    const ktx2_placement p = place_ktx2(format, kvd_length, levels, raw, zstd);
     std::vector<unsigned char> b(p.size, 0);
-    put_ktx2_header(b, cube, format, p);
+    put_ktx2_header(b, cube, format, p, zstd);
     put_dfd(b, p.dfd_offset, format, p.dfd_total, texel_bytes(format));
     put_key_values(b, p.kvd_offset, kv);
-    const ktx2_clamp_counts seen = put_ktx2_texels(b, cube, format, p);
+    for (std::size_t l = 0; l < levels.size(); ++l)
+        if (!levels[l].empty()) std::memcpy(b.data() + p.offset[l], levels[l].data(), levels[l].size());
     if (counts) *counts = seen;
     return b;
 }
 
-void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format,
-                        const std::string& writer, const std::vector<std::pair<std::string, std::string>>& metadata) {
-    write_file_atomic(path, encode_ktx2_cubemap(cube, format, writer, path, nullptr, metadata));
+void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
+                        const std::vector<std::pair<std::string, std::string>>& metadata, const ktx2_encoding& encoding) {
+    write_file_atomic(path, encode_ktx2_cubemap(cube, format, writer, path, nullptr, metadata, encoding));
 }
 
 // ---- reader ------------------------------------------------------------------------------------
@@ -515,41 +588,76 @@ cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::
     if (!known_format(k.vk_format))
         throw bad("vkFormat " + std::to_string(k.vk_format) +
                   " (readable: 109 R32G32B32A32_SFLOAT, 97 R16G16B16A16_SFLOAT, 122 B10G11R11_UFLOAT_PACK32, "
-                  "123 E5B9G9R9_UFLOAT_PACK32)");
+                  "123 E5B9G9R9_UFLOAT_PACK32, 143 BC6H_UFLOAT_BLOCK, 1000066000 ASTC_4x4_SFLOAT_BLOCK, "
+                  "1000066004 ASTC_6x6_SFLOAT_BLOCK)");
     const ktx2_format fmt = ktx2_format(k.vk_format);
     const std::size_t tb = texel_bytes(fmt);
-    if (k.supercompression != 0) throw bad("supercompressed");
+    const bool zstd = k.supercompression == ktx2_ss_zstd;
+    if (k.supercompression != 0 && !zstd)
+        throw bad("supercompression scheme " + std::to_string(k.supercompression) + " (readable: 0 none, 2 Zstandard)");
     if (k.face_count != 6 || k.layer_count != 0 || k.pixel_depth != 0) throw bad("not a single cubemap");
     if (k.pixel_width != k.pixel_height || k.pixel_width < 1 || k.pixel_width > 65536) throw bad("faces not square");
-    const std::uint32_t want_type_size = fmt == ktx2_format::rgba16f ? 2 : 4;
+    const std::uint32_t want_type_size = type_size(fmt);
     if (k.type_size != want_type_size)
         throw bad("typeSize " + std::to_string(k.type_size) + " for vkFormat " + std::to_string(k.vk_format) +
                   " (expected " + std::to_string(want_type_size) + ")");
     if (k.dfd.size() < 7 || (k.dfd[5] & 0xffu) != tb)
-        throw bad("data format descriptor's bytesPlane0 differs from the " + std::to_string(tb) +
-                  "-byte texel of vkFormat " + std::to_string(k.vk_format));
+        throw bad("data format descriptor's bytesPlane0 differs from the " + std::to_string(tb) + "-byte " +
+                  (ktx2_block_compressed(fmt) ? "block" : "texel") + " of vkFormat " + std::to_string(k.vk_format));
+    if (int(k.levels.size()) > full_chain(int(k.pixel_width))) throw bad("more levels than the face size allows");
+    // Every level's size inflated, bounded before anything is allocated.
+    std::uint64_t total = 0;
+    for (std::size_t l = 0; l < k.levels.size(); ++l) {
+        const std::size_t s = std::max<std::size_t>(1, std::size_t(k.pixel_width) >> l);
+        total += level_bytes(fmt, s) + 6 * s * s * 12; // the stored level and its floats
+    }
+    if (total > max_inflated_bytes) throw bad("the decoded cubemap would take more than 2 GiB");
     cubemap_rgb32f c = cubemap_rgb32f::zeros(int(k.pixel_width), int(k.levels.size()));
-    if (int(k.levels.size()) > full_chain(c.size)) throw bad("more levels than the face size allows");
+    std::vector<unsigned char> inflated;
     for (std::size_t l = 0; l < k.levels.size(); ++l) {
         const std::size_t s = std::size_t(c.face_size(int(l)));
-        if (k.levels[l].byte_length != 6 * s * s * tb || k.levels[l].byte_offset % tb)
-            throw bad("level " + std::to_string(l) + " has the wrong size or alignment");
-        std::size_t at = std::size_t(k.levels[l].byte_offset);
+        const std::size_t want = level_bytes(fmt, s);
+        std::span<const unsigned char> level;
+        if (zstd) {
+            if (k.levels[l].uncompressed_byte_length != want)
+                throw bad("level " + std::to_string(l) + " inflates to " + std::to_string(k.levels[l].uncompressed_byte_length) +
+                          " bytes, expected " + std::to_string(want));
+            const unsigned char* src = b.data() + k.levels[l].byte_offset;
+            const std::size_t len = std::size_t(k.levels[l].byte_length);
+            const unsigned long long content = ZSTD_getFrameContentSize(src, len);
+            if (content != want) throw bad("level " + std::to_string(l) + " is not one Zstandard frame of " + std::to_string(want) + " bytes");
+            inflated.assign(want, 0);
+            const std::size_t got = ZSTD_decompress(inflated.data(), want, src, len);
+            if (ZSTD_isError(got) || got != want)
+                throw bad("level " + std::to_string(l) + ": Zstandard data corrupt (" +
+                          (ZSTD_isError(got) ? std::string(ZSTD_getErrorName(got)) : std::to_string(got) + " bytes") + ")");
+            level = std::span<const unsigned char>(inflated);
+        } else {
+            if (k.levels[l].byte_length != want || k.levels[l].byte_offset % tb)
+                throw bad("level " + std::to_string(l) + " has the wrong size or alignment");
+            level = b.subspan(std::size_t(k.levels[l].byte_offset), want);
+        }
+        if (ktx2_block_compressed(fmt)) {
+            const std::size_t fb = block_image_bytes(fmt, int(s));
+            for (std::size_t f = 0; f < 6; ++f) c.levels[l][f] = decode_block_image(fmt, level.data() + f * fb, fb, int(s));
+            continue;
+        }
+        std::size_t at = 0;
         for (std::size_t f = 0; f < 6; ++f)
-            for (std::size_t t = 0; t < s * s; ++t) {
+            for (std::size_t t = 0; t < s * s; ++t, at += tb) {
                 float* out = c.levels[l][f].data() + 3 * t;
                 switch (fmt) {
                 case ktx2_format::rgba32f:
-                    for (std::size_t ch = 0; ch < 3; ++ch) out[ch] = std::bit_cast<float>(get32(b, at + 4 * ch));
+                    for (std::size_t ch = 0; ch < 3; ++ch) out[ch] = std::bit_cast<float>(get32(level, at + 4 * ch));
                     break;
                 case ktx2_format::rgba16f:
                     for (std::size_t ch = 0; ch < 3; ++ch)
-                        out[ch] = half_to_float(static_cast<std::uint16_t>(b[at + 2 * ch] | (b[at + 2 * ch + 1] << 8)));
+                        out[ch] = half_to_float(static_cast<std::uint16_t>(level[at + 2 * ch] | (level[at + 2 * ch + 1] << 8)));
                     break;
-                case ktx2_format::b10g11r11: unpack_b10g11r11(get32(b, at), out); break;
-                case ktx2_format::e5b9g9r9: unpack_e5b9g9r9(get32(b, at), out); break;
+                case ktx2_format::b10g11r11: unpack_b10g11r11(get32(level, at), out); break;
+                case ktx2_format::e5b9g9r9: unpack_e5b9g9r9(get32(level, at), out); break;
+                default: break;
                 }
-                at += tb;
             }
     }
     return c;
@@ -557,8 +665,14 @@ cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::
 
 // ---- quantisation report -----------------------------------------------------------------------
 
-std::vector<ktx2_quantisation_level> ktx2_quantisation_report(const cubemap_rgb32f& cube, ktx2_format format) {
+std::vector<ktx2_quantisation_level> ktx2_quantisation_report(const cubemap_rgb32f& cube, ktx2_format format,
+                                                             const cubemap_rgb32f* decoded) {
     check_cube(cube, "<quantisation report>");
+    cubemap_rgb32f own;
+    if (ktx2_block_compressed(format) && !decoded) {
+        own = decode_ktx2_cubemap(encode_ktx2_cubemap(cube, format, "report"), "<quantisation report>");
+        decoded = &own;
+    }
     std::vector<ktx2_quantisation_level> out;
     for (std::size_t l = 0; l < cube.levels.size(); ++l) {
         ktx2_quantisation_level q;
@@ -576,11 +690,13 @@ std::vector<ktx2_quantisation_level> ktx2_quantisation_report(const cubemap_rgb3
         q.floor = mean > 0.0 ? 1e-3 * mean : 1e-30;
         double sq = 0.0;
         ktx2_clamp_counts seen;
-        for (const auto& face : cube.levels[l])
-            for (std::size_t t = 0; t < face.size() / 3; ++t) {
-                const float* in = face.data() + 3 * t;
+        for (std::size_t f = 0; f < 6; ++f)
+            for (std::size_t t = 0; t < cube.levels[l][f].size() / 3; ++t) {
+                const float* in = cube.levels[l][f].data() + 3 * t;
                 float dec[3];
-                ktx2_roundtrip_texel(format, in, dec);
+                if (decoded)
+                    for (int c = 0; c < 3; ++c) dec[c] = decoded->levels[l][f][3 * t + std::size_t(c)];
+                else ktx2_roundtrip_texel(format, in, dec);
                 count_clamps(format, in, seen);
                 for (int c = 0; c < 3; ++c) {
                     if (std::isnan(in[c])) continue;

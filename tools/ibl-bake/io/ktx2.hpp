@@ -8,15 +8,17 @@
 //
 // What is written (all integers little-endian; offsets from the start of the file):
 //   offset 0    identifier  AB 4B 54 58 20 32 30 BB 0D 0A 1A 0A  ("«KTX 20»\r\n\x1A\n")
-//          12   vkFormat    one of the four formats below
-//          16   typeSize    4 (RGBA32F), 2 (RGBA16F), 4 (the two PACK32 formats: the size of the packed word)
+//          12   vkFormat    one of the seven formats below
+//          16   typeSize    4 (RGBA32F), 2 (RGBA16F), 4 (the two PACK32 formats: the size of the packed word),
+//                           1 (the block formats)
 //          20   pixelWidth  n (face size of level 0), 24 pixelHeight n, 28 pixelDepth 0
 //          32   layerCount  0 (not an array), 36 faceCount 6, 40 levelCount L (>= 1),
-//          44   supercompressionScheme 0 (none)
+//          44   supercompressionScheme 0 (none) or 2 (Zstandard, ktx2_encoding::zstd_level > 0)
 //          48   index: dfdByteOffset, dfdByteLength, kvdByteOffset, kvdByteLength (u32),
 //               sgdByteOffset = 0, sgdByteLength = 0 (u64)
 //          80   level index, L entries of {byteOffset, byteLength, uncompressedByteLength} (u64),
 //               level 0 (finest) first
+//               (with Zstandard: byteLength the deflated size, uncompressedByteLength the raw size)
 //   80+24L      data format descriptor (Khronos Data Format Specification 1.3), dfdTotalSize then
 //               one basic descriptor block: vendorId 0 / descriptorType 0, versionNumber 2 (1.3),
 //               descriptorBlockSize 24 + 16 x samples, colorModel RGBSDA (1), colorPrimaries BT709
@@ -39,10 +41,19 @@
 //                                    B (2) with mantissa offset 18, each with the same exponent
 //                                    sample at offset 27. Mantissas carry no FLOAT qualifier (they
 //                                    are unsigned integers scaled by the exponent).   (dfdTotalSize 124)
+//     block formats (as KTX-Software's createDFDCompressed writes them): colorModel BC6H (131) or
+//                 ASTC (162), texelBlockDimension 3 3 0 0 (4x4) or 5 5 0 0 (6x6), bytesPlane0 16
+//                 (kept with Zstandard: the DFD describes the inflated data), one sample: channel 0
+//                 (BC6H_COLOR / ASTC_DATA), offset 0, length field 127; BC6H_UFLOAT: FLOAT (0x80),
+//                 lower 0 (0.0f), upper 0x3F800000; ASTC SFLOAT: FLOAT|SIGNED (0xC0), lower
+//                 0xBF800000, upper 0x3F800000                               (dfdTotalSize 44)
 //   then        key/value data: one entry "KTXwriter" = "<writer>\0" (the spec's recommended
 //               key), {u32 keyAndValueByteLength, key\0value\0, padding to 4}
 //   then        the mip levels, SMALLEST FIRST (level L-1 ... level 0), each starting at a
-//               multiple of lcm(texel size, 4) (16, 8, 4, 4 bytes), zero padding between.
+//               multiple of lcm(texel or block size, 4) (16, 8, 4, 4; 16 for blocks; 1 when
+//               supercompressed), zero padding between. Block formats store every level down to
+//               1x1 (a level smaller than a block is one block: its texels outside the level are
+//               padding the encoder ignores), faces in order, blocks row-major from t = 0.
 //               A level holds the 6 faces in order +X, -X, +Y, -Y, +Z, -Z, each s x s texels
 //               (s = max(1, n >> level)), rows from t = 0; RGBA texels with A = 1, packed texels
 //               as one little-endian u32.
@@ -95,9 +106,23 @@ enum class ktx2_format : std::uint32_t {
     rgba16f = 97,    ///< VK_FORMAT_R16G16B16A16_SFLOAT
     b10g11r11 = 122, ///< VK_FORMAT_B10G11R11_UFLOAT_PACK32
     e5b9g9r9 = 123,  ///< VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
+    bc6h = 143,                    ///< VK_FORMAT_BC6H_UFLOAT_BLOCK (4x4 blocks of 16 bytes)
+    astc4x4 = 1000066000,          ///< VK_FORMAT_ASTC_4x4_SFLOAT_BLOCK (VK_EXT_texture_compression_astc_hdr)
+    astc6x6 = 1000066004,          ///< VK_FORMAT_ASTC_6x6_SFLOAT_BLOCK
 };
 
-/// Bytes of one texel in the file: 16, 8, 4, 4.
+/// Encoder effort of the block-compressed formats (io/block_codec.hpp says what each does).
+enum class block_quality { fast, normal, exhaustive };
+
+/// How encode_ktx2_cubemap encodes: the block formats' effort and threads, and the optional
+/// Zstandard supercompression of every level (KTX2 supercompressionScheme 2).
+struct ktx2_encoding {
+    block_quality quality = block_quality::normal;
+    int zstd_level = 0;   ///< 0: none; 1..22: each level deflated with this Zstandard level
+    unsigned threads = 1; ///< encoder threads (0 = all cores); the bytes do not depend on it
+};
+
+/// Bytes of one texel (16, 8, 4, 4) or, for the block formats, of one block (16).
 std::size_t ktx2_texel_bytes(ktx2_format format) noexcept;
 /// Largest finite value channel c (0 R, 1 G, 2 B) can hold: FLT_MAX, 65504, 65024/65024/64512, 65408.
 float ktx2_channel_max(ktx2_format format, int channel) noexcept;
@@ -119,13 +144,15 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
                                                const std::string& writer = "ibl-bake",
                                                const std::string& name = "<ktx2>",
                                                ktx2_clamp_counts* counts = nullptr,
-                                               const std::vector<std::pair<std::string, std::string>>& metadata = {});
+                                               const std::vector<std::pair<std::string, std::string>>& metadata = {},
+                                               const ktx2_encoding& encoding = {});
 /// encode_ktx2_cubemap + write_file_atomic.
 /// metadata: extra key/value pairs (UTF-8 keys without NUL, not starting with "KTX"; written sorted
 /// by key after KTXwriter's place in that order).
 void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format,
                         const std::string& writer = "ibl-bake",
-                        const std::vector<std::pair<std::string, std::string>>& metadata = {});
+                        const std::vector<std::pair<std::string, std::string>>& metadata = {},
+                        const ktx2_encoding& encoding = {});
 
 /// Parsed header and indices of a KTX2 file (for tests and verification).
 struct ktx2_level {
@@ -141,11 +168,12 @@ struct ktx2_info {
     std::vector<std::pair<std::string, std::string>> key_values; ///< value without its final NUL
 };
 
-/// Parses and validates a KTX2 file of the kind written here (uncompressed, bounds and
-/// alignment of every index checked). Throws image_error naming `name`.
+/// Parses and validates a KTX2 file of the kind written here (bounds and alignment of every
+/// index checked). Throws image_error naming `name`.
 ktx2_info parse_ktx2(std::span<const unsigned char> bytes, const std::string& name = "<ktx2>");
 
-/// Reads back a cubemap written by encode_ktx2_cubemap (any of the four formats, alpha dropped).
+/// Reads back a cubemap written by encode_ktx2_cubemap (any of its formats, alpha dropped; the
+/// block formats decoded as a GPU decodes them; Zstandard levels inflated, at most 2 GiB in all).
 /// Besides the header it checks typeSize and the DFD's bytesPlane0 against the format.
 cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> bytes, const std::string& name = "<ktx2>");
 
@@ -185,6 +213,8 @@ struct ktx2_quantisation_level {
     std::size_t negative_clamped = 0;
     std::size_t nan = 0;
 };
-std::vector<ktx2_quantisation_level> ktx2_quantisation_report(const cubemap_rgb32f& cube, ktx2_format format);
+/// `decoded`: the cube as the file decodes (a block format's result; computed here when absent).
+std::vector<ktx2_quantisation_level> ktx2_quantisation_report(const cubemap_rgb32f& cube, ktx2_format format,
+                                                             const cubemap_rgb32f* decoded = nullptr);
 
 } // namespace ibl_bake

@@ -51,7 +51,10 @@ const char* to_string(input_form f) noexcept {
     return std::array{"auto", "latlong", "hcross", "vcross", "hstrip", "vstrip", "faces", "ktx2"}[std::size_t(f)];
 }
 const char* to_string(prefilter_choice p) noexcept { return std::array{"fis", "fast"}[std::size_t(p)]; }
-const char* to_string(ktx2_storage f) noexcept { return std::array{"rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"}[std::size_t(f)]; }
+const char* to_string(ktx2_storage f) noexcept {
+    return std::array{"rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9", "bc6h", "astc4x4", "astc6x6"}[std::size_t(f)];
+}
+const char* to_string(block_quality q) noexcept { return std::array{"fast", "normal", "exhaustive"}[std::size_t(q)]; }
 
 std::string to_string(const sh_window_choice& w) {
     return w.k == sh_window_choice::kind::hanning ? w.text : w.k == sh_window_choice::kind::none ? "none" : "auto";
@@ -230,10 +233,17 @@ option_map file_options() {
              o.max_input_pixels = std::uint64_t(parse_integer("--max-input-pixels", v, 1, 1ll << 32));
          }}},
         {"--ktx2-format", {true, [](bake_options& o, const std::string& v) {
-             const std::string f = choice("--ktx2-format", v, std::initializer_list<std::string>{"f16", "f32", "rgba16f", "rgba32f", "b10g11r11", "e5b9g9r9"});
+             const std::string f = choice("--ktx2-format", v,
+                                          std::initializer_list<std::string>{"f16", "f32", "rgba16f", "rgba32f", "b10g11r11",
+                                                                             "e5b9g9r9", "bc6h", "astc4x4", "astc6x6"});
              o.ktx2_format = choice("--ktx2-format", f == "f16" ? "rgba16f" : f == "f32" ? "rgba32f" : f,
-                                    {ktx2_storage::rgba16f, ktx2_storage::rgba32f, ktx2_storage::b10g11r11, ktx2_storage::e5b9g9r9});
+                                    {ktx2_storage::rgba16f, ktx2_storage::rgba32f, ktx2_storage::b10g11r11, ktx2_storage::e5b9g9r9,
+                                     ktx2_storage::bc6h, ktx2_storage::astc4x4, ktx2_storage::astc6x6});
          }}},
+        {"--ktx2-quality", {true, [](bake_options& o, const std::string& v) {
+             o.ktx2_quality = choice("--ktx2-quality", v, {block_quality::fast, block_quality::normal, block_quality::exhaustive});
+         }}},
+        {"--ktx2-zstd", {true, [](bake_options& o, const std::string& v) { o.ktx2_zstd = int(parse_integer("--ktx2-zstd", v, 0, 22)); }}},
     };
 }
 
@@ -327,7 +337,10 @@ std::string usage_text() {
            "  --threads N        worker threads, 0 = all cores (default)\n"
            "  --quality Q        low | default | high\n"
            "  --layout L[,L..]   files per specular level: faces (default) | latlong | cross | octahedral\n"
-           "  --ktx2-format F    rgba16f (default; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9\n"
+           "  --ktx2-format F    rgba16f (default of every preset; f16) | rgba32f (f32) | b10g11r11 | e5b9g9r9 |\n"
+           "                     bc6h | astc4x4 | astc6x6 (block-compressed HDR, 8 / 8 / 3.56 bits per texel)\n"
+           "  --ktx2-quality Q   fast | normal (default) | exhaustive: the block formats' encoder effort\n"
+           "  --ktx2-zstd N      Zstandard supercompression of the KTX2 files, level 1..22 (default 0: none)\n"
            "  --quiet            no progress on stderr\n"
            "  --checks C         fast (default: cheaper references, checks <= 1/4 of the run) | full | none\n"
            "                     (none: no reference checks; the products are written unchecked)\n"

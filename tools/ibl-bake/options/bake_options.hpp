@@ -19,7 +19,11 @@
 //   --threads N         worker threads, 0 = all cores (default 0), at most 256
 //   --quality Q         low | default | high (the mapping is quality_settings below)
 //   --ktx2-format F     rgba16f = f16 (default, VK_FORMAT_R16G16B16A16_SFLOAT) | rgba32f = f32 |
-//                       b10g11r11 (VK_FORMAT_B10G11R11_UFLOAT_PACK32) | e5b9g9r9 (..._E5B9G9R9_UFLOAT_PACK32)
+//                       b10g11r11 (VK_FORMAT_B10G11R11_UFLOAT_PACK32) | e5b9g9r9 (..._E5B9G9R9_UFLOAT_PACK32) |
+//                       bc6h (VK_FORMAT_BC6H_UFLOAT_BLOCK) | astc4x4 / astc6x6 (..._ASTC_4x4/6x6_SFLOAT_BLOCK);
+//                       every preset writes rgba16f unless this option says otherwise
+//   --ktx2-quality Q    fast | normal (default) | exhaustive: the block formats' encoder effort
+//   --ktx2-zstd N       0 (default: none) | 1..22: Zstandard supercompression level of the KTX2 files
 //   --quiet             no progress output on stderr
 //   --sh-bands B        SH bands 2..5 (default: 3; a scene plan's 2 or 3)
 //   --sh-window W       auto (default) | none | a Hanning width > 0 (applies to irradiance / shader)
@@ -59,6 +63,8 @@
 #include <ibl/runtime/lookup.hpp>
 #include <ibl/runtime/roughness_mip.hpp>
 
+#include "io/ktx2.hpp" // ktx2_format's block_quality
+
 namespace ibl_bake {
 
 class usage_error : public std::runtime_error {
@@ -91,7 +97,7 @@ enum class input_form { automatic, latlong, hcross, vcross, hstrip, vstrip, face
 /// --prefilter: the specular chain's filter (fis: filtered importance sampling; fast: the fast filter).
 enum class prefilter_choice { fis, fast };
 /// --ktx2-format: the storage of the KTX2 files (ktx2.hpp's ktx2_format of the same names).
-enum class ktx2_storage { rgba16f, rgba32f, b10g11r11, e5b9g9r9 };
+enum class ktx2_storage { rgba16f, rgba32f, b10g11r11, e5b9g9r9, bc6h, astc4x4, astc6x6 };
 
 /// --sh-window: automatic (a Hanning window when the SH go negative), none, or a Hanning width.
 struct sh_window_choice {
@@ -110,6 +116,7 @@ const char* to_string(runtime_choice r) noexcept;
 const char* to_string(level_layout l) noexcept;
 const char* to_string(input_form f) noexcept;
 const char* to_string(ktx2_storage f) noexcept;
+const char* to_string(block_quality q) noexcept;
 const char* to_string(prefilter_choice p) noexcept;
 std::string to_string(const sh_window_choice& w);
 /// "g1" | "nl"
@@ -129,6 +136,8 @@ struct bake_options {
     unsigned threads = 0;
     quality q = quality::standard;
     ktx2_storage ktx2_format = ktx2_storage::rgba16f;
+    block_quality ktx2_quality = block_quality::normal; ///< --ktx2-quality
+    int ktx2_zstd = 0;                                  ///< --ktx2-zstd: 0 none, else the Zstandard level
     std::string part;            ///< --part: EXR part name (empty: the first with R, G, B)
     input_form input_layout = input_form::automatic;
     std::vector<level_layout> layouts{level_layout::faces}; ///< per-level files

@@ -33,6 +33,7 @@ std::vector<std::unique_ptr<stage>> all_stages() {
     s.push_back(make_lookup_stage());
     s.push_back(make_split_sum_stage());
     s.push_back(make_preview_stage());
+    s.push_back(make_compression_stage());
     s.push_back(make_target_check_stage());
     s.push_back(make_compare_full_stage());
     return s;

@@ -101,6 +101,14 @@ struct bake_context {
     std::optional<ibl::lobe_lut> lobe_b; ///< its B-part kernel table (f_B, r_B, 0, 0)
     std::optional<ibl::lobe_taps_lut> taps; ///< the two-tap table (--runtime taps2)
     diffuse_data diffuse;
+    /// specular.ktx2 as written (encoded once, by the specular stage: the block formats take time)
+    /// and as a renderer decodes it.
+    struct stored_ktx2 {
+        std::vector<unsigned char> bytes;
+        ibl::cubemap<float> decoded{1};
+        double encode_ms = 0.0;
+    };
+    std::shared_ptr<const stored_ktx2> specular_file;
     product_times measured; ///< filled by the pipeline after each product stage
 
     // the scene's targets (the target_check stage): one line per missed target

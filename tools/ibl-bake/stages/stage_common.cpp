@@ -372,9 +372,20 @@ ktx2_format ktx2_format_of(ktx2_storage storage) {
     case ktx2_storage::rgba32f: return ktx2_format::rgba32f;
     case ktx2_storage::b10g11r11: return ktx2_format::b10g11r11;
     case ktx2_storage::e5b9g9r9: return ktx2_format::e5b9g9r9;
+    case ktx2_storage::bc6h: return ktx2_format::bc6h;
+    case ktx2_storage::astc4x4: return ktx2_format::astc4x4;
+    case ktx2_storage::astc6x6: return ktx2_format::astc6x6;
     case ktx2_storage::rgba16f: break;
     }
     return ktx2_format::rgba16f;
+}
+
+ktx2_encoding ktx2_encoding_of(const bake_options& o) {
+    ktx2_encoding e;
+    e.quality = o.ktx2_quality;
+    e.zstd_level = o.ktx2_zstd;
+    e.threads = o.threads;
+    return e;
 }
 
 void json_quantisation(json_writer& j, const std::vector<ktx2_quantisation_level>& q, ktx2_storage format) {

@@ -313,6 +313,7 @@ public:
         ms_ = ctx.prog.end();
         map_ = &ctx.diffuse.map;
         format_ = ctx.opt.ktx2_format;
+        encoding_ = ktx2_encoding_of(ctx.opt);
         attrs_ = product_conventions(ctx, "irradiance", "texel holds the irradiance E(n) (not E/pi) for the normal n through "
                                                         "it; diffuse = albedo E(n) / pi");
         checked_ = ctx.opt.checks != check_mode::none;
@@ -345,7 +346,7 @@ public:
                          [this, face](const std::string& p) { write_exr(p, face_image(*map_, face, 0), attrs_); }});
         f.push_back({"irradiance.ktx2", [this](const std::string& p) {
                          write_ktx2_cubemap(p, cubemap_to_rgb32f(*map_), ktx2_format_of(format_), "ibl-bake " + version_string(),
-                                            attrs_);
+                                            attrs_, encoding_);
                      }});
         return f;
     }
@@ -373,6 +374,7 @@ public:
 private:
     int size_ = 32, max_face_ = 32;
     ktx2_storage format_ = ktx2_storage::rgba16f;
+    ktx2_encoding encoding_;
     std::vector<std::pair<std::string, std::string>> attrs_;
     const ibl::cubemap<float>* map_ = nullptr;
     double ms_ = 0.0, sun_mean_ = 0.0, sun_max_ = 0.0;

@@ -59,9 +59,13 @@ public:
         dirs_ = ibl::lookup_error_directions(ctx.qs.ref_grid, ctx.light);
         ibl::specular_lookup_desc chosen = ctx.opt.specular_lookup;
         chosen.mapping = ctx.plan.specular.policy.mapping;
-        const std::vector<unsigned char> bytes =
-            encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain), ktx2_format_of(ctx.opt.ktx2_format), "check");
-        const ibl::cubemap<float> stored = cubemap_from_rgb32f(decode_ktx2_cubemap(bytes, "specular.ktx2"));
+        const ibl::cubemap<float> stored = ctx.specular_file ? ctx.specular_file->decoded
+                                                             : cubemap_from_rgb32f(decode_ktx2_cubemap(
+                                                                   encode_ktx2_cubemap(cubemap_to_rgb32f(*ctx.chain),
+                                                                                       ktx2_format_of(ctx.opt.ktx2_format), "check",
+                                                                                       "specular.ktx2", nullptr, {},
+                                                                                       ktx2_encoding_of(ctx.opt)),
+                                                                   "specular.ktx2"));
         const bool textbook = textbook_lookup(ctx.opt.specular_lookup);
         ibl::specular_lookup_desc other = textbook ? ibl::specular_lookup_desc::accurate() : ibl::specular_lookup_desc::textbook();
         other.mapping = chosen.mapping;

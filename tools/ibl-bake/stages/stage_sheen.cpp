@@ -58,6 +58,7 @@ public:
         lut_ = ibl::make_sheen_lut(std::uint32_t(ctx.opt.lut_size), ibl::sheen_lut_default_nodes, ctx.ex);
         ms_ = ctx.prog.end();
         format_ = ctx.opt.ktx2_format;
+        encoding_ = ktx2_encoding_of(ctx.opt);
         samples_ = po.samples_per_level;
         attrs_ = product_conventions(ctx, "sheen", "level l holds the Charlie-lobe LD at roughness l / (levels - 1) (linear), read "
                                                    "at R by textureLod(chain, R, lod(r))");
@@ -99,7 +100,7 @@ public:
                              [this, l, face](const std::string& p) { write_exr(p, face_image(chain_, face, l), attrs_); }});
         f.push_back({"sheen.ktx2", [this](const std::string& p) {
                          write_ktx2_cubemap(p, cubemap_to_rgb32f(chain_), ktx2_format_of(format_), "ibl-bake " + version_string(),
-                                            attrs_);
+                                            attrs_, encoding_);
                      }});
         f.push_back({"sheen_lut.exr", [this](const std::string& p) {
                          image_rgb32f img(int(lut_.size), int(lut_.size));
@@ -146,6 +147,7 @@ private:
     const ibl::disk_light<double>* sun_ = nullptr;
     ibl::dfg_lut lut_;
     ktx2_storage format_ = ktx2_storage::rgba16f;
+    ktx2_encoding encoding_;
     std::vector<std::uint32_t> samples_;
     std::vector<ibl::error_metrics> levels_;
     double ms_ = 0.0, check_ms_ = 0.0, lut_max_abs_ = 0.0;

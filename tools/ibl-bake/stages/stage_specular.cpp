@@ -97,9 +97,23 @@ public:
         layouts_ = ctx.opt.layouts;
         floor_ = 1e-3 * std::max(ctx.lstats.mean, 1e-30);
         checked_ = ctx.opt.checks != check_mode::none;
+        // specular.ktx2, encoded once (the block formats' encoder takes time: reported apart from
+        // the product's) and decoded as a renderer reads it
+        ctx.prog.begin("encode specular.ktx2");
+        auto file = std::make_shared<bake_context::stored_ktx2>();
+        const cubemap_rgb32f rgb = cubemap_to_rgb32f(*chain_);
+        const auto t_enc = std::chrono::steady_clock::now();
+        file->bytes = encode_ktx2_cubemap(rgb, ktx2_format_of(format_), "ibl-bake " + version_string(), "specular.ktx2", nullptr,
+                                          metadata_, ktx2_encoding_of(ctx.opt));
+        file->encode_ms = ms_since(t_enc);
+        const cubemap_rgb32f decoded = decode_ktx2_cubemap(file->bytes, "specular.ktx2");
+        file->decoded = cubemap_from_rgb32f(decoded);
+        ctx.prog.end();
+        file_ = file;
+        ctx.specular_file = file;
         if (!checked_) return;
         ctx.prog.begin("check specular");
-        quant_ = ktx2_quantisation_report(cubemap_to_rgb32f(*chain_), ktx2_format_of(format_));
+        quant_ = ktx2_quantisation_report(rgb, ktx2_format_of(format_), &decoded);
         for (int k = 0; k < chain_->levels(); ++k) {
             ctx.prog.label("level " + std::to_string(k) + "/" + std::to_string(chain_->levels() - 1));
             checks_.push_back(check_level(ctx, k));
@@ -121,6 +135,7 @@ private:
     ktx2_storage format_ = ktx2_storage::rgba16f;
     std::vector<level_layout> layouts_;
     std::vector<ktx2_quantisation_level> quant_;
+    std::shared_ptr<const bake_context::stored_ktx2> file_;
     std::vector<std::pair<std::string, std::string>> metadata_;
     /// The chain's keys plus the level and its roughness (ibl.level, ibl.roughness).
     exr_attributes level_attrs(int l) const {
@@ -249,9 +264,7 @@ std::vector<file_out> specular_stage::files() const {
             f.push_back({base + "octahedral.exr",
                          [this, l](const std::string& p) { write_exr(p, octahedral_from_cube(*chain_, l), level_attrs(l)); }});
     }
-    f.push_back({"specular.ktx2", [this](const std::string& p) {
-                     write_ktx2_cubemap(p, cubemap_to_rgb32f(*chain_), ktx2_format_of(format_), "ibl-bake " + version_string(), metadata_);
-                 }});
+    f.push_back({"specular.ktx2", [this](const std::string& p) { write_file_atomic(p, file_->bytes); }});
     return f;
 }
 

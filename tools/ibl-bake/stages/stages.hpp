@@ -51,6 +51,7 @@ std::unique_ptr<stage> make_sheen_stage();
 std::unique_ptr<stage> make_lookup_stage();
 std::unique_ptr<stage> make_split_sum_stage();
 std::unique_ptr<stage> make_preview_stage();
+std::unique_ptr<stage> make_compression_stage();
 std::unique_ptr<stage> make_target_check_stage();
 std::unique_ptr<stage> make_compare_full_stage();
 
@@ -226,6 +227,8 @@ void write_text(const std::string& path, const std::string& text);
 
 /// The KTX2 format of a --ktx2-format (the same names).
 ktx2_format ktx2_format_of(ktx2_storage storage);
+/// How the KTX2 files are encoded: --ktx2-quality, --ktx2-zstd and --threads.
+ktx2_encoding ktx2_encoding_of(const bake_options& o);
 
 /// Writes the quantisation of a cube stored as `format` (per level: max and RMS relative error of
 /// the decoded values, values above the format's range and negatives clamped) as a JSON object.

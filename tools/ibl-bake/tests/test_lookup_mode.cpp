@@ -181,6 +181,15 @@ void check_answers(const std::string& text, const std::vector<std::vector<double
     CHECK(n == want.size());
 }
 
+/// The numbers of each answer line.
+std::vector<std::vector<double>> parse_answers(const std::string& text) {
+    std::istringstream answers(text);
+    std::vector<std::vector<double>> rows;
+    std::string line;
+    while (std::getline(answers, line)) rows.push_back(numbers(line));
+    return rows;
+}
+
 } // namespace
 
 TEST_CASE("lookup: answers equal the library's runtime functions on the bake's files") {
@@ -443,4 +452,48 @@ TEST_CASE("lookup: sheen and dfg_sheen answer from the sheen chain and table") {
     std::ofstream(s / "q2.txt") << "sheen 0 1 0 0.5\n";
     CHECK(shell(tool + " --lookup " + (s / "plain") + " < " + (s / "q2.txt") + " > " + (s / "a2.txt")) == 1);
     CHECK(slurp(s / "a2.txt").find("bake with --sheen") != std::string::npos);
+}
+
+TEST_CASE("lookup: block-compressed bakes answer from their decoded files, near the uncompressed bake") {
+    scratch s("ibl_bake_lookup_blocks");
+    const std::string common = " --quiet --size 32 --lut-size 16 --quality low --checks none --threads 2 --out ";
+    REQUIRE(shell(tool + common + (s / "f16") + " >/dev/null 2>&1") == 0);
+    std::string q;
+    std::vector<dvec3> dirs;
+    std::vector<double> rough;
+    for (int k = 0; k < 24; ++k) {
+        const dvec3 d = glm::normalize(dvec3(std::sin(0.7 * k + 0.1), std::cos(1.3 * k), std::cos(0.3 * k + 0.5)));
+        const double r = 0.25 + 0.75 * std::fmod(0.37 * k, 1.0);
+        char buf[160];
+        std::snprintf(buf, sizeof buf, "specular %.17g %.17g %.17g %.17g\n", d.x, d.y, d.z, r);
+        q += buf;
+        dirs.push_back(d);
+        rough.push_back(r);
+    }
+    std::ofstream(s / "q.txt") << q;
+    REQUIRE(shell(tool + " --lookup " + (s / "f16") + " < " + (s / "q.txt") + " > " + (s / "a_f16.txt")) == 0);
+    const std::vector<std::vector<double>> f16 = parse_answers(slurp(s / "a_f16.txt"));
+    for (const char* format : {"bc6h", "astc4x4", "astc6x6"}) {
+        CAPTURE(format);
+        const fs::path dir = s / format;
+        REQUIRE(shell(tool + common + dir.string() + " --ktx2-format " + format + " >/dev/null 2>&1") == 0);
+        // the answers are the library's lookup on the file as decoded (the GPU's decode)
+        const ibl::cubemap<float> chain = load_chain(dir / "specular.ktx2");
+        std::vector<std::vector<double>> want;
+        for (std::size_t i = 0; i < dirs.size(); ++i) {
+            const fvec3 ld = ibl::specular_lookup(chain, fvec3(dirs[i]), float(rough[i]));
+            want.push_back({ld.x, ld.y, ld.z});
+        }
+        REQUIRE(shell(tool + " --lookup " + dir.string() + " < " + (s / "q.txt") + " > " + (s / "a.txt")) == 0);
+        const std::string answers = slurp(s / "a.txt");
+        check_answers(answers, want);
+        // and within a few percent of the uncompressed bake at r >= 0.25
+        const std::vector<std::vector<double>> got = parse_answers(answers);
+        REQUIRE(got.size() == f16.size());
+        double sq = 0.0, ref = 0.0;
+        for (std::size_t i = 0; i < got.size(); ++i)
+            for (int c = 0; c < 3; ++c) sq += (got[i][std::size_t(c)] - f16[i][std::size_t(c)]) * (got[i][std::size_t(c)] - f16[i][std::size_t(c)]),
+                                        ref += f16[i][std::size_t(c)] * f16[i][std::size_t(c)];
+        CHECK(std::sqrt(sq / ref) < 0.05);
+    }
 }

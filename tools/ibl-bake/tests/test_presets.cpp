@@ -163,3 +163,48 @@ TEST_CASE("--prefilter fast: the chain by the fast filter, named in report.json 
     }
     CHECK(shell(base + "--prefilter slow --out " + (s / "bad") + " >/dev/null 2>&1") == 2);
 }
+
+TEST_CASE("--ktx2-format bc6h / astc: the compression check in report.json, Zstandard files, every KTX2 in the format") {
+    scratch s("ibl_bake_compression_tests");
+    const std::string base = tool + " --quiet --size 32 --lut-size 8 --quality low --threads 2 ";
+    REQUIRE(shell(base + "--ktx2-format bc6h --out " + (s / "bc6h") + " >/dev/null") == 0);
+    REQUIRE(shell(base + "--ktx2-format astc4x4 --ktx2-quality fast --ktx2-zstd 5 --out " + (s / "astc") + " >/dev/null") == 0);
+    REQUIRE(shell(base + "--out " + (s / "f16") + " >/dev/null") == 0);
+    for (const char* dir : {"bc6h", "astc"}) {
+        CAPTURE(dir);
+        const auto r = ibl_examples::parse_json(slurp(s / (std::string(dir) + "/report.json")));
+        const ibl_examples::json_value* c = r.find("compression");
+        REQUIRE(c);
+        const bool bc6h = std::string(dir) == "bc6h";
+        CHECK(c->find("format")->string == (bc6h ? "bc6h" : "astc4x4"));
+        CHECK(c->find("quality")->string == (bc6h ? "normal" : "fast"));
+        CHECK(c->find("zstd_level")->number == (bc6h ? 0.0 : 5.0));
+        CHECK(c->find("file_bytes")->number == double(fs::file_size(s / (std::string(dir) + "/specular.ktx2"))));
+        const double bpt = c->find("bits_per_texel")->number;
+        if (bc6h) CHECK(bpt > 8.0); // 8 bits per texel plus the header and the 1-block levels' padding
+        else CHECK(bpt < 8.0);      // Zstandard on top
+        CHECK(c->find("encode_ms")->number > 0.0);
+        const auto& levels = c->find("levels")->values;
+        CHECK(levels.size() == r.find("specular")->find("levels")->values.size());
+        for (const auto& l : levels) {
+            CHECK(l.find("rmsle")->number > 0.0);
+            CHECK(l.find("rmsle")->number < 0.1);
+            CHECK(std::isfinite(l.find("seam_step_compressed")->number));
+        }
+        const double shaded = c->find("lookup")->find("rel_rmse_r_ge_0_25")->number;
+        CHECK(shaded > 0.0);
+        CHECK(shaded < 0.05);
+        CHECK(c->find("preview_rel_rmse")->number < 0.05);
+        // every KTX2 of the bake in the format
+        for (const char* file : {"specular.ktx2", "irradiance.ktx2"}) {
+            const std::vector<unsigned char> bytes = ibl_bake::read_file(s / (std::string(dir) + "/" + file));
+            const ibl_bake::ktx2_info k = ibl_bake::parse_ktx2(bytes);
+            CHECK(k.vk_format == (bc6h ? 143u : 1000066000u));
+            CHECK(k.supercompression == (bc6h ? 0u : 2u));
+        }
+    }
+    // the uncompressed bake has no compression section
+    CHECK_FALSE(ibl_examples::parse_json(slurp(s / "f16/report.json")).find("compression"));
+    CHECK(shell(base + "--ktx2-format bc7 --out " + (s / "bad") + " >/dev/null 2>&1") == 2);
+    CHECK(shell(base + "--ktx2-zstd 23 --out " + (s / "bad") + " >/dev/null 2>&1") == 2);
+}
