@@ -7,7 +7,11 @@ SwiftShader's WebGL2), compared with the C++.
            tools/viewer/index.html?test=preview render ibl-bake's preview grid from specular.ktx2,
            dfg.hpp, lobe_lut.hpp and lobe_lut_b.hpp (the lobe model; --preset filament / gltf bake the
            split sum; --runtime taps2 the two-tap table, lobe_taps.hpp), sh.json and report.json, and compares its pixels with the bake's own
-           preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below.
+           preview.png (the C++ renderer, stage_preview.cpp) within the derived bound below. A bake
+           with a block-compressed chain or irradiance map (--ktx2-format bc6h, astc4x4, astc6x6) is
+           compared instead with the same grid rendered by `ibl-bake --lookup` (the C++ runtime
+           shading the files as stored, decoded as a GPU decodes them; lookup_preview): preview.png
+           is rendered from the float products, so it holds no compression error.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
            interactive viewer to --out (docs/shaders-viewer.png).
   prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
@@ -15,13 +19,20 @@ SwiftShader's WebGL2), compared with the C++.
            and the fast filter's taps per level) and compares every texel of every convolved level
            with the C++ chain (ibl::prefilter, method fast) within half-float rounding: |GLSL - C++|
            <= 2^-11 |C++| per value.
+  bc6h     the browser's own BC6H decoder against the library's: the page uploads the blocks that
+           `bc6h_fixtures` prints (random blocks of every mode code, reserved ones included, and
+           blocks ibl::bc6h_encode_image made of HDR content) as one EXT_texture_compression_bptc
+           texture, reads every texel with texelFetch into an RGBA32F target, and every value must
+           be exactly the library's half (bc6h_decode_block_half). Exit 77 (skipped) where the
+           browser lacks EXT_texture_compression_bptc or EXT_color_buffer_float.
   numeric  lets tools/viewer/numeric.frag.glsl evaluate the GLSL functions on a fixed grid of
            inputs and compares them with the same grid evaluated by the library in C++
            (glsl_reference, tests/browser/glsl_reference.cpp); the page uploads the fixtures
            `glsl_reference --fixtures` prints (served as /bake/numeric_fixtures.json).
 
 Everything this script starts (the bake, Chromium, the HTTP server thread) ends before it returns.
-Exit status 0 = pass. docs/shaders.md explains the bounds.
+Exit status 0 = pass, 77 = skipped (the page says what the browser lacks). docs/shaders.md explains
+the bounds.
 """
 
 import argparse
@@ -162,6 +173,9 @@ class Server:
         self.thread.join()
 
 
+SKIP = 77  # exit status of a test the browser cannot run (CTest SKIP_RETURN_CODE)
+
+
 def run_page(chromium, url, profile, timeout, server):
     cmd = [chromium, "--headless=new", "--use-angle=swiftshader", "--enable-unsafe-swiftshader", "--no-sandbox",
            "--disable-gpu-sandbox", "--no-first-run", "--disable-background-networking", "--disable-component-update",
@@ -267,9 +281,111 @@ def report_model(bake_dir):
     return rt.get("runtime_model", {}).get("name", "split-sum")
 
 
-def compare_preview(bake_dir, result):
+# The block-compressed formats (ktx2.js KTX2_FORMATS): the preview test compares them with the C++
+# runtime shading the same compressed files (lookup_preview), not with preview.png.
+BLOCK_FORMATS = {"BC6H_UFLOAT_BLOCK", "ASTC_4x4_SFLOAT_BLOCK", "ASTC_6x6_SFLOAT_BLOCK"}
+PREVIEW_MATERIALS = [((0.8, 0.8, 0.8), 0.0), ((0.95, 0.64, 0.54), 1.0)]  # stage_preview's rows
+
+
+def srgb_png(x, exposure):
+    """image_png.cpp tonemap_png (Reinhard): a linear value -> its 8-bit sRGB code."""
+    x *= exposure
+    if not x > 0.0:
+        return 0
+    x = 1.0 if math.isinf(x) else x / (1.0 + x)
+    y = (12.92 * x if x <= 0.0031308 else 1.055 * x ** (1.0 / 2.4) - 0.055) * 255.0 + 0.5
+    return int(min(max(y, 0.0), 255.0))
+
+
+def run_lookup(tool, folder, lines):
+    """The answers of `ibl-bake --lookup folder` to the query lines, one list of floats each."""
+    out = subprocess.run([tool, "--lookup", folder], input="\n".join(lines) + "\n", check=True, capture_output=True,
+                         text=True).stdout.split("\n")
+    bad = next((l for l in out if l.startswith("error")), None)
+    if bad or len(out) < len(lines):
+        raise RuntimeError("ibl-bake --lookup: " + (bad or f"{len(out)} answers to {len(lines)} queries"))
+    return [[float(x) for x in out[i].split()] for i in range(len(lines))]
+
+
+def lookup_preview(tool, bake_dir, ss, work):
+    """The preview grid (stage_preview.cpp's camera, spheres, materials, sub-samples, exposure,
+    Reinhard, sRGB, 8 bits) rendered by `ibl-bake --lookup`: the C++ runtime shading the bake's files
+    as stored (the block formats decoded as a GPU decodes them). Spheres: `shade` (the runtime model,
+    and lights.json's sun as a disk light). Background: `specular d 0` asked of a view of the folder
+    without lights.json (so the answer is level 0 of the chain alone, bilinear, as the page's
+    textureLod(chain, d, 0)), plus the sun's radiance where d is inside its cap (d.dir >= cos r,
+    1 - cos r = omega / (2 pi); never in the preview's view). Returns RGB bytes, top row first."""
+    report = json.load(open(os.path.join(bake_dir, "report.json")))
+    if report["plan"]["runtime"].get("first_level", 0) != 0:
+        raise RuntimeError("first_level > 0: the page's background (level 0) is not the lookup's roughness-0 LD")
+    sunless = os.path.join(work, "sunless")
+    os.makedirs(sunless)
+    for name in os.listdir(bake_dir):
+        if name != "lights.json":
+            os.symlink(os.path.join(bake_dir, name), os.path.join(sunless, name))
+    sun = None
+    if os.path.exists(os.path.join(bake_dir, "lights.json")):
+        suns = [l for l in json.load(open(os.path.join(bake_dir, "lights.json")))["lights"] if l.get("type") == "sun"]
+        if suns:
+            sun = (suns[0]["direction"], 1.0 - min(max(suns[0]["solid_angle"] / (2.0 * math.pi), 0.0), 1.0), suns[0]["radiance"])
+    fwd, right, up = preview_camera(report["source"]["brightest_direction"])
+    exposure = report["preview"]["exposure"]
+    w, h = COLS * CELL, ROWS * CELL
+    radius = 0.45 * CELL
+    tan_h = math.tan(0.5 * math.pi / 2)
+    tan_v = tan_h * h / w
+    v = [-c for c in fwd]
+    spheres, background, where = [], [], []  # where: per sub-sample (is sphere, index, sun radiance or None)
+    for py in range(h):
+        for px in range(w):
+            for sy in range(ss):
+                for sx in range(ss):
+                    fx, fy = px + (sx + 0.5) / ss, py + (sy + 0.5) / ss
+                    ci, cj = min(int(fx) // CELL, COLS - 1), min(int(fy) // CELL, ROWS - 1)
+                    lx, ly = (fx - (ci + 0.5) * CELL) / radius, -(fy - (cj + 0.5) * CELL) / radius
+                    d2 = lx * lx + ly * ly
+                    if d2 < 1.0:  # orthographic sphere
+                        z = math.sqrt(1.0 - d2)
+                        n = [lx * right[k] + ly * up[k] - z * fwd[k] for k in range(3)]
+                        base, metal = PREVIEW_MATERIALS[cj]
+                        where.append((True, len(spheres), None))
+                        spheres.append("shade %r %r %r %r %r %r %r %r %r %r %r" % (*n, *v, 0.25 * ci, metal, *base))
+                    else:
+                        nx, ny = 2.0 * fx / w - 1.0, 1.0 - 2.0 * fy / h
+                        d = [fwd[k] + nx * tan_h * right[k] + ny * tan_v * up[k] for k in range(3)]
+                        dn = math.sqrt(sum(c * c for c in d))
+                        in_sun = sun and sum(d[k] / dn * sun[0][k] for k in range(3)) >= sun[1]
+                        where.append((False, len(background), sun[2] if in_sun else None))
+                        background.append("specular %r %r %r 0" % tuple(d))
+    a_sphere = run_lookup(tool, bake_dir, spheres)
+    a_background = run_lookup(tool, sunless, background)
+    rgb = bytearray(3 * w * h)
+    k, inv = 0, 1.0 / (ss * ss)
+    for i in range(w * h):
+        acc = [0.0, 0.0, 0.0]
+        for _ in range(ss * ss):
+            is_sphere, j, disk = where[k]
+            k += 1
+            a = a_sphere[j] if is_sphere else a_background[j]
+            for c in range(3):
+                acc[c] += a[c] + (disk[c] if disk else 0.0)
+        for c in range(3):  # stage_preview stores the mean as float, image_png tone-maps it
+            rgb[3 * i + c] = srgb_png(struct.unpack("<f", struct.pack("<f", acc[c] * inv))[0], exposure)
+    return bytes(rgb)
+
+
+def compare_preview(bake_dir, result, reference=None):
+    """The page's pixels against preview.png, or against `reference` (lookup_preview's RGB bytes:
+    the C++ shading of the stored, block-compressed files)."""
     w, h, ref = read_png_rgb(os.path.join(bake_dir, "preview.png"))
     got = base64.b64decode(result["rgb"])
+    if reference is not None:  # what compression does to the picture (not a test: the float products' C++)
+        float_ref = ref
+        ref = reference
+        dmax = max(abs(a - b) for a, b in zip(float_ref, ref))
+        dmean = sum(abs(a - b) for a, b in zip(float_ref, ref)) / len(ref)
+        print(f"reference: ibl-bake --lookup on the bake's stored files ({result['info']['chain_format']}); it differs from "
+              f"preview.png (the float products) by max {dmax}, mean {dmean:.4f} (8-bit units, per channel)")
     if (w, h) != (result["width"], result["height"]) or len(got) != len(ref):
         raise RuntimeError(f"size mismatch: preview.png {w}x{h}, page {result['width']}x{result['height']}")
     info = result["info"]
@@ -288,6 +404,12 @@ def compare_preview(bake_dir, result):
     #   (Vulkan guarantees only subTexelPrecisionBits >= 4) errs by a fraction of the difference
     #   of neighbouring texels, which no relative bound covers: the bound holds for SwiftShader.
     chain_eps = {"R16G16B16A16_SFLOAT": 2.0 ** -11, "R32G32B32A32_SFLOAT": 0.0, "B10G11R11_UFLOAT_PACK32": 2.0 ** -6}
+    #   Block formats (BC6H, ASTC HDR): compared with the C++ shading the same compressed files
+    #   (lookup_preview), both sides read the same decoded halves: no storage error. That the
+    #   browser's BC6H decoder returns the library's halves bit for bit is glsl_browser_bc6h's
+    #   check; ASTC HDR is assumed to decode as astcenc does (no browser here offers it).
+    if reference is not None:
+        chain_eps.update({f: 0.0 for f in BLOCK_FORMATS})
     # The irradiance map (plan.runtime.diffuse "irradiance_map") is stored in the same formats and
     # read by one bilinear lookup: the same relative bound per texel format.
     formats = [info["chain_format"]]
@@ -458,11 +580,100 @@ def compare_prefilter(fixtures, result):
     return ok
 
 
+# ---- BC6H decoder comparison --------------------------------------------------------------------------
+
+BC6H_MODES = {0x02: 3, 0x06: 4, 0x0a: 5, 0x0e: 6, 0x12: 7, 0x16: 8, 0x1a: 9, 0x1e: 10, 0x03: 11, 0x07: 12, 0x0b: 13, 0x0f: 14}
+
+
+def bc6h_mode(block):
+    """The mode (1..14) of a BC6H block from its low bits, or 'reserved 0bXXXXX'."""
+    if block[0] & 3 < 2:
+        return f"mode {1 + (block[0] & 3)}"
+    code = block[0] & 0x1f
+    return f"mode {BC6H_MODES[code]}" if code in BC6H_MODES else f"reserved {code:05b}"
+
+
+def float_to_half_exact(f):
+    """The half-float bit pattern of f if f is exactly a half (a BC6H texel always is), else None."""
+    try:
+        h = struct.unpack("<H", struct.pack("<e", f))[0]
+    except OverflowError:
+        return None
+    back = struct.unpack("<e", struct.pack("<H", h))[0]
+    return h if back == f and math.copysign(1.0, back) == math.copysign(1.0, f) else None
+
+
+def compare_bc6h(fixtures, result):
+    """Every texel of every block: the browser's decode (RGBA32F) against the library's halves, bit for bit."""
+    blocks = base64.b64decode(fixtures["blocks"])
+    halves = base64.b64decode(fixtures["halves"])
+    per, count = fixtures["blocks_per_row"], fixtures["count"]
+    w, h = result["width"], result["height"]
+    if result["blocks"] != count or w != 4 * per or h != 4 * ((count + per - 1) // per):
+        raise RuntimeError(f"the page decoded {result['blocks']} blocks into {w} x {h}, expected {count} blocks")
+    got = struct.unpack(f"<{4 * w * h}f", base64.b64decode(result["rgba"]))
+    expect = struct.unpack(f"<{48 * count}H", halves)
+    by_mode, by_group, bad_blocks = {}, {}, []
+    group_of = [None] * count
+    for g in fixtures["groups"]:
+        for i in range(g["first"], g["first"] + g["count"]):
+            group_of[i] = g["name"]
+    texels = 0
+    for i in range(count):
+        bx, by = i % per, i // per
+        block = blocks[16 * i:16 * i + 16]
+        mode = bc6h_mode(block)
+        stats = by_mode.setdefault(mode, [0, 0, 0])  # blocks, texels, mismatching texels
+        gstats = by_group.setdefault(group_of[i], [0, 0])  # blocks, mismatching blocks
+        stats[0] += 1
+        gstats[0] += 1
+        wrong = []
+        for t in range(16):
+            x, y = 4 * bx + t % 4, 4 * by + t // 4
+            k = 4 * (y * w + x)
+            lib = expect[48 * i + 3 * t:48 * i + 3 * t + 3]
+            gpu = [float_to_half_exact(got[k + c]) for c in range(3)]
+            texels += 1
+            stats[1] += 1
+            if list(lib) != gpu:
+                stats[2] += 1
+                wrong.append((t, lib, [got[k + c] for c in range(3)]))
+        if wrong:
+            gstats[1] += 1
+            bad_blocks.append((i, mode, group_of[i], block, wrong))
+    print(f"renderer: {result['renderer']}")
+    print(f"blocks compared {count}, texels {texels} (x 3 channels, every value's half bits); the library's values: "
+          f"{sum(1 for v in expect if v)} of {len(expect)} nonzero, {len(set(expect))} distinct, largest "
+          f"{struct.unpack('<e', struct.pack('<H', max(expect)))[0]:g}")
+    print("per mode (blocks, texels, mismatching texels):")
+    order = [f"mode {m}" for m in range(1, 15)] + sorted(k for k in by_mode if k.startswith("reserved"))
+    for m in order:
+        if m in by_mode:
+            b, t, bad = by_mode[m]
+            print(f"  {m:18s} {b:6d} blocks {t:7d} texels  {bad} mismatching")
+    print("per group (blocks, mismatching blocks):")
+    for g in fixtures["groups"]:
+        b, bad = by_group[g["name"]]
+        print(f"  {g['name']:48s} {b:6d}  {bad}")
+    for i, mode, group, block, wrong in bad_blocks[:20]:
+        print(f"MISMATCH block {i} ({group}, {mode}) bytes {block.hex()}:")
+        for t, lib, gpu in wrong[:16]:
+            gbits = [float_to_half_exact(v) for v in gpu]
+            print(f"  texel {t} (x {t % 4}, y {t // 4}): library halves {[f'0x{v:04x}' for v in lib]} = "
+                  f"{[struct.unpack('<e', struct.pack('<H', v))[0] for v in lib]}; browser {gpu} (half bits "
+                  f"{[('0x%04x' % v) if v is not None else 'not a half' for v in gbits]})")
+    if len(bad_blocks) > 20:
+        print(f"... and {len(bad_blocks) - 20} more mismatching blocks")
+    ok = not bad_blocks
+    print("PASS" if ok else f"FAIL: {len(bad_blocks)} of {count} blocks differ")
+    return ok
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "screenshot"], required=True)
+    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "bc6h", "screenshot"], required=True)
     ap.add_argument("--tool", help="ibl-bake (preview)")
-    ap.add_argument("--reference", help="glsl_reference (numeric, prefilter)")
+    ap.add_argument("--reference", help="glsl_reference (numeric, prefilter), bc6h_fixtures (bc6h)")
     ap.add_argument("--chromium", default="chromium")
     ap.add_argument("--repo", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
     ap.add_argument("--size", default="32", help="face size of the preview test's bake")
@@ -490,6 +701,9 @@ def main():
             prefilter_fixtures = subprocess.run([a.reference, "--prefilter-fixtures"], check=True, capture_output=True,
                                                 text=True).stdout
             open(os.path.join(bake_dir, "prefilter_fixtures.json"), "w").write(prefilter_fixtures)
+        if a.mode == "bc6h":  # the blocks and the library's halves; the page reads the blocks
+            bc6h_fixtures = subprocess.run([a.reference], check=True, capture_output=True, text=True).stdout
+            open(os.path.join(bake_dir, "bc6h_fixtures.json"), "w").write(bc6h_fixtures)
         server = Server(os.path.abspath(a.repo), bake_dir)
         if a.mode == "screenshot":
             try:
@@ -510,14 +724,23 @@ def main():
             result = run_page(a.chromium, url, os.path.join(work, "profile"), a.timeout, server)
         finally:
             server.close()
+        if result.get("kind") == "skip":
+            print(f"SKIPPED: {result['reason']} (renderer {result.get('renderer')})")
+            print("extensions: " + ", ".join(result.get("extensions") or []))
+            return SKIP
         if a.mode == "preview":
-            ok = compare_preview(bake_dir, result)
+            reference = None
+            if result["info"]["chain_format"] in BLOCK_FORMATS or result["info"].get("irradiance_format") in BLOCK_FORMATS:
+                reference = lookup_preview(a.tool, bake_dir, result["info"]["preview_ss"], work)
+            ok = compare_preview(bake_dir, result, reference)
             if a.keep:
                 os.makedirs(a.keep, exist_ok=True)
                 shutil.copytree(bake_dir, os.path.join(a.keep, "bake"), dirs_exist_ok=True)
                 open(os.path.join(a.keep, "browser_rgb.bin"), "wb").write(base64.b64decode(result["rgb"]))
         elif a.mode == "prefilter":
             ok = compare_prefilter(json.loads(prefilter_fixtures), result)
+        elif a.mode == "bc6h":
+            ok = compare_bc6h(json.loads(bc6h_fixtures), result)
         else:
             ok = compare_numeric(a.reference, result)
         return 0 if ok else 1

@@ -6,6 +6,9 @@
 //   glsl=URL     where ibl_*.glsl live (default ../../include/ibl/glsl/)
 //   test=preview render ibl-bake's preview.png exactly (640 x 256) and POST the pixels to `report`
 //   test=numeric evaluate the GLSL functions on fixed inputs (numeric.frag.glsl) and POST them
+//   test=prefilter filter the fixtures' sky with ibl_prefilter.glsl and POST every texel
+//   test=bc6h    read every texel of the BC6H fixtures' blocks through EXT_texture_compression_bptc
+//                and POST them (tests/browser/run_browser_test.py --mode bc6h compares them)
 //   report=URL   where a test POSTs its JSON result (tests/browser/run_browser_test.py serves it)
 //   roughness=, ev=, lookup=, scatter=, grid=1, light=1, ss=  the controls' initial values
 // Without bake=, pick the folder with the file picker (the browser reads it locally).
@@ -22,6 +25,10 @@
 // "taps2": the two-tap table, uploaded as the two RGBA textures of ibl_common.glsl's storage split,
 // and the spheres are shaded by the two-tap model, ibl_lobe_taps2_sample); else by the split
 // sum.
+// The KTX2 files may hold any of ibl-bake's formats: the block-compressed ones (--ktx2-format bc6h,
+// astc4x4, astc6x6) are uploaded as blocks through the browser's EXT_texture_compression_bptc (BC6H)
+// or WEBGL_compressed_texture_astc with the 'hdr' profile (ASTC); where the browser lacks them, and
+// for Zstandard-supercompressed files (--ktx2-zstd N), the panel says so and nothing is drawn.
 
 import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
 import { packSource, parseFastShapes, fastTaps } from './refilter.js';
@@ -192,19 +199,63 @@ function compile(gl, vsrc, fsrc) {
     return p;
 }
 
-/// A cube texture with every stored level, uploaded as stored (faces +X..-Z, rows from t = 0).
-function uploadCube(gl, cube) {
+/// The WebGL extension object that uploads a block-compressed cube (ktx2.js KTX2_FORMATS: BC6H through
+/// EXT_texture_compression_bptc, ASTC HDR through WEBGL_compressed_texture_astc with the 'hdr'
+/// profile), or an Error that says what the browser lacks (never an upload the GPU would decode as
+/// something else: an LDR-only ASTC decoder turns HDR blocks into its error colour).
+export function blockExtension(gl, format, name) {
+    const ext = gl.getExtension(format.extension);
+    const other = 'bake with --ktx2-format rgba16f (or another format this browser offers)';
+    if (!ext) return new Error(`${name} is ${format.name} (--ktx2-format ${format.option}): this browser's WebGL2 has no ` +
+                               `${format.extension}; ${other}`);
+    if (format.profile) {
+        const profiles = ext.getSupportedProfiles ? ext.getSupportedProfiles() : [];
+        if (!profiles.includes(format.profile))
+            return new Error(`${name} is ${format.name} (--ktx2-format ${format.option}): this browser's ${format.extension} ` +
+                             `offers the profiles [${profiles.join(', ')}], not '${format.profile}' (HDR blocks); ${other}`);
+    }
+    return ext;
+}
+
+/// The first of a bake's KTX2 cubes (chain, irradiance map) in a block format this browser cannot
+/// upload, as blockExtension's Error; null when every cube can be uploaded.
+function unsupportedBlockFormat(gl, bake) {
+    for (const [name, cube] of [['specular.ktx2', bake.chain], ['irradiance.ktx2', bake.irradiance]]) {
+        const e = cube && cube.format.block ? blockExtension(gl, cube.format, name) : null;
+        if (e instanceof Error) return e;
+    }
+    return null;
+}
+
+/// A cube texture with every stored level, uploaded as stored (faces +X..-Z, rows from t = 0; the
+/// block formats with compressedTexImage2D, blocks row-major from t = 0).
+function uploadCube(gl, cube, name = 'the cube') {
+    let ext = null;
+    if (cube.format.block) {
+        ext = blockExtension(gl, cube.format, name);
+        if (ext instanceof Error) throw ext;
+    }
     const tex = gl.createTexture();
     gl.bindTexture(gl.TEXTURE_CUBE_MAP, tex);
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
     gl.pixelStorei(gl.UNPACK_FLIP_Y_WEBGL, false);
-    const [internal, format, type] = cube.format.gl.map((n) => gl[n]);
     if (cube.vkFormat === 109 && !gl.getExtension('OES_texture_float_linear'))
         throw new Error('an RGBA32F chain needs OES_texture_float_linear to be filtered');
-    cube.levels.forEach((lv, l) => {
-        for (let f = 0; f < 6; ++f)
-            gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, l, internal, lv.size, lv.size, 0, format, type, lv.faces[f]);
-    });
+    if (ext) {
+        const internal = ext[cube.format.internal];
+        cube.levels.forEach((lv, l) => {
+            for (let f = 0; f < 6; ++f)
+                gl.compressedTexImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, l, internal, lv.size, lv.size, 0, lv.faces[f]);
+        });
+        const err = gl.getError();
+        if (err !== gl.NO_ERROR) throw new Error(`${name}: compressedTexImage2D failed (GL error 0x${err.toString(16)})`);
+    } else {
+        const [internal, format, type] = cube.format.gl.map((n) => gl[n]);
+        cube.levels.forEach((lv, l) => {
+            for (let f = 0; f < 6; ++f)
+                gl.texImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, l, internal, lv.size, lv.size, 0, format, type, lv.faces[f]);
+        });
+    }
     gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_BASE_LEVEL, 0);
     gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MAX_LEVEL, cube.levels.length - 1);
     gl.texParameteri(gl.TEXTURE_CUBE_MAP, gl.TEXTURE_MIN_FILTER, gl.LINEAR_MIPMAP_LINEAR);
@@ -302,14 +353,17 @@ class Renderer {
 
     setBake(bake) {
         const gl = this.gl;
+        // A block format the browser cannot upload: refuse before anything changes (the loaded bake stays).
+        const unsupported = unsupportedBlockFormat(gl, bake);
+        if (unsupported) throw unsupported;
         this.bake = bake;
         this.rt = runtimeOf(bake);
-        this.chainTex = uploadCube(gl, bake.chain);
+        this.chainTex = uploadCube(gl, bake.chain, 'specular.ktx2');
         const rtj = bake.report && bake.report.plan && bake.report.plan.runtime;
         const lut = uploadLut(gl, bake.dfg, rtj && rtj.dfg_channels_layout);
         this.lutTex = lut.tex;
         this.lutFormat = lut.format;
-        this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance) : this.chainTex;
+        this.irrTex = bake.irradiance ? uploadCube(gl, bake.irradiance, 'irradiance.ktx2') : this.chainTex;
         const lobe = bake.lobe ? uploadLut(gl, bake.lobe, null) : null; // (A, B, s, r_eff): four channels as stored
         this.lobeTex = lobe ? lobe.tex : this.lutTex;
         this.lobeFormat = lobe ? lobe.format : null;
@@ -515,6 +569,12 @@ async function runPreviewTest() {
     canvas.width = 640;
     canvas.height = 256;
     const r = new Renderer(canvas, await libraryGlsl(), await fetchText('viewer.frag.glsl'));
+    // a block format this browser cannot upload: skipped, with the reason (the driver exits 77)
+    const unsupported = unsupportedBlockFormat(r.gl, bake);
+    if (unsupported) {
+        await post({ kind: 'skip', reason: unsupported.message, renderer: rendererName(r.gl), extensions: r.gl.getSupportedExtensions() });
+        return;
+    }
     r.setBake(bake);
     r.draw({ mode: 0 });
     r.gl.finish();
@@ -650,6 +710,60 @@ async function runPrefilterTest() {
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff, taps: tapsDiff, renderer: rendererName(gl) });
 }
 
+/// The BC6H decoder test: the fixtures' blocks (tests/browser/bc6h_fixtures.cpp, served as
+/// bc6h_fixtures.json) uploaded as one COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT texture, `blocks_per_row`
+/// blocks per block row, every texel read by texelFetch into an RGBA32F target and posted as the
+/// target's float bits (rows from y = 0 = the texture's t = 0). Without EXT_texture_compression_bptc
+/// (or float render targets) it posts kind 'skip' with the reason and the browser's extensions.
+async function runBc6hTest() {
+    const canvas = document.getElementById('view');
+    const gl = canvas.getContext('webgl2');
+    if (!gl) throw new Error('WebGL2 is not available');
+    const missing = ['EXT_texture_compression_bptc', 'EXT_color_buffer_float'].filter((e) => !gl.getExtension(e));
+    if (missing.length) {
+        await post({ kind: 'skip', reason: `this WebGL2 lacks ${missing.join(' and ')}`, renderer: rendererName(gl),
+                     extensions: gl.getSupportedExtensions() });
+        return;
+    }
+    const bptc = gl.getExtension('EXT_texture_compression_bptc');
+    const fx = JSON.parse(await fetchText(params.get('bake') + 'bc6h_fixtures.json'));
+    const raw = Uint8Array.from(atob(fx.blocks), (c) => c.charCodeAt(0));
+    const per = fx.blocks_per_row, count = raw.length / 16, rows = Math.ceil(count / per);
+    const W = 4 * per, H = 4 * rows;
+    const data = new Uint8Array(16 * per * rows); // the last block row padded with zero blocks
+    data.set(raw);
+    const tex = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.compressedTexImage2D(gl.TEXTURE_2D, 0, bptc.COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, W, H, 0, data);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+    gl.texParameteri(gl.TEXTURE_2D, gl.TEXTURE_MAX_LEVEL, 0);
+    const upload = gl.getError();
+    if (upload !== gl.NO_ERROR) throw new Error(`compressedTexImage2D (BC6H ${W} x ${H}) failed: GL error 0x${upload.toString(16)}`);
+    const program = compile(gl, VERTEX, HEADER + 'uniform highp sampler2D u_blocks;\nout vec4 o_color;\n' +
+                            'void main() { o_color = texelFetch(u_blocks, ivec2(gl_FragCoord.xy), 0); }\n');
+    gl.activeTexture(gl.TEXTURE1); // the render target binds here, on no sampler's unit
+    const target = gl.createTexture();
+    gl.bindTexture(gl.TEXTURE_2D, target);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, W, H, 0, gl.RGBA, gl.FLOAT, null);
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, target, 0);
+    if (gl.checkFramebufferStatus(gl.FRAMEBUFFER) !== gl.FRAMEBUFFER_COMPLETE) throw new Error('the RGBA32F target is incomplete');
+    gl.viewport(0, 0, W, H);
+    gl.useProgram(program);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_blocks'), 0);
+    gl.bindVertexArray(gl.createVertexArray());
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    const out = new Float32Array(4 * W * H);
+    gl.readPixels(0, 0, W, H, gl.RGBA, gl.FLOAT, out);
+    const err = gl.getError();
+    if (err !== gl.NO_ERROR) throw new Error(`GL error 0x${err.toString(16)}`);
+    await post({ kind: 'bc6h', width: W, height: H, blocks: count, rgba: toBase64(new Uint8Array(out.buffer)),
+                 renderer: rendererName(gl), version: gl.getParameter(gl.VERSION) });
+}
+
 // ---- interactive viewer ----------------------------------------------------------------------------
 
 async function runViewer() {
@@ -740,6 +854,7 @@ async function main() {
         if (testMode === 'preview') await runPreviewTest();
         else if (testMode === 'numeric') await runNumericTest();
         else if (testMode === 'prefilter') await runPrefilterTest();
+        else if (testMode === 'bc6h') await runBc6hTest();
         else await runViewer();
     } catch (e) {
         log(String(e.stack || e));
