@@ -75,17 +75,20 @@ void study(const std::string& name, const ibl::cubemap<float>& src, bool quick) 
         for (int l = 0; l < chain.levels(); ++l) {
             const int s = chain.size(l);
             std::vector<float> a, b;
+            const float* faces[6];
+            for (int f = 0; f < 6; ++f) faces[f] = rgb.levels[std::size_t(l)][std::size_t(f)].data();
+            const auto t0 = std::chrono::steady_clock::now();
+            const std::vector<unsigned char> blocks = ibl_bake::encode_block_level(c.format, faces, s, c.quality, 2);
+            ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+            const std::size_t fb = ibl_bake::block_image_bytes(c.format, s);
             for (int f = 0; f < 6; ++f) {
                 const std::vector<float>& face = rgb.levels[std::size_t(l)][std::size_t(f)];
-                const auto t0 = std::chrono::steady_clock::now();
-                const std::vector<unsigned char> blocks = ibl_bake::encode_block_image(c.format, face.data(), s, c.quality, 2);
-                ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-                const std::vector<float> d = ibl_bake::decode_block_image(c.format, blocks.data(), blocks.size(), s);
+                const std::vector<float> d = ibl_bake::decode_block_image(c.format, blocks.data() + std::size_t(f) * fb, fb, s);
                 a.insert(a.end(), face.begin(), face.end());
                 b.insert(b.end(), d.begin(), d.end());
-                bytes += blocks.size();
                 texels += std::size_t(s) * std::size_t(s);
             }
+            bytes += blocks.size();
             err.push_back(rmsle(a, b));
         }
         std::printf("| %s | %.0f | %.2f |", c.name, ms, 8.0 * double(bytes) / double(texels));

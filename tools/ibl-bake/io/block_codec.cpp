@@ -147,6 +147,24 @@ std::vector<unsigned char> encode_block_image(ktx2_format format, const float* r
     return astc_encode(ktx2_block_dim(format), rgb, s, quality, threads == 0 ? std::max(1u, std::thread::hardware_concurrency()) : threads);
 }
 
+std::vector<unsigned char> encode_block_level(ktx2_format format, const float* const faces[6], int s, block_quality quality,
+                                              unsigned threads) {
+    const int b = ktx2_block_dim(format);
+    if (format == ktx2_format::bc6h && s >= b && s % b == 0) {
+        const std::size_t face = std::size_t(s) * std::size_t(s) * 3;
+        std::vector<float> stacked(6 * face);
+        for (std::size_t f = 0; f < 6; ++f) std::copy(faces[f], faces[f] + face, stacked.begin() + std::ptrdiff_t(f * face));
+        return ibl::bc6h_encode_image(stacked.data(), s, 6 * s, bc6h_quality_of(quality), ibl::thread_executor{threads});
+    }
+    std::vector<unsigned char> out;
+    out.reserve(6 * block_image_bytes(format, s));
+    for (int f = 0; f < 6; ++f) {
+        const std::vector<unsigned char> blocks = encode_block_image(format, faces[f], s, quality, threads);
+        out.insert(out.end(), blocks.begin(), blocks.end());
+    }
+    return out;
+}
+
 std::vector<float> decode_block_image(ktx2_format format, const unsigned char* blocks, std::size_t bytes, int s) {
     if (s < 1 || bytes != block_image_bytes(format, s))
         throw image_error("<blocks>", "compressed image of " + std::to_string(bytes) + " bytes for a " + std::to_string(s) + "^2 image");

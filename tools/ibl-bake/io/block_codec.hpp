@@ -37,6 +37,13 @@ std::size_t block_image_bytes(ktx2_format format, int s) noexcept;
 std::vector<unsigned char> encode_block_image(ktx2_format format, const float* rgb, int s, block_quality quality,
                                               unsigned threads = 1);
 
+/// The six faces of one cube level (faces[f]: s x s x 3 floats) as their blocks, face after face
+/// (encode_block_image of each, concatenated). Where the blocks tile every face (s a multiple of
+/// the block size) BC6H encodes the six faces as one s x 6s image: one parallel pass per level
+/// instead of six, the same bytes.
+std::vector<unsigned char> encode_block_level(ktx2_format format, const float* const faces[6], int s, block_quality quality,
+                                              unsigned threads = 1);
+
 /// Decodes such blocks (exactly block_image_bytes(format, s) of them) to s x s x 3 floats.
 std::vector<float> decode_block_image(ktx2_format format, const unsigned char* blocks, std::size_t bytes, int s);
 

@@ -458,12 +458,9 @@ std::vector<unsigned char> level_texels(const cubemap_rgb32f& cube, std::size_t 
     for (const std::vector<float>& face : cube.levels[l])
         for (std::size_t t = 0; t < s * s; ++t) count_clamps(format, face.data() + 3 * t, seen);
     if (ktx2_block_compressed(format)) {
-        const std::size_t fb = block_image_bytes(format, int(s));
-        for (std::size_t f = 0; f < 6; ++f) {
-            const std::vector<unsigned char> blocks = encode_block_image(format, cube.levels[l][f].data(), int(s), enc.quality, enc.threads);
-            std::memcpy(b.data() + f * fb, blocks.data(), fb);
-        }
-        return b;
+        const float* faces[6];
+        for (std::size_t f = 0; f < 6; ++f) faces[f] = cube.levels[l][f].data();
+        return encode_block_level(format, faces, int(s), enc.quality, enc.threads);
     }
     const std::size_t tb = texel_bytes(format);
     std::size_t at = 0;
