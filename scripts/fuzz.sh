@@ -2,7 +2,9 @@
 # scripts/fuzz.sh [RUNS] — build the libFuzzer harness of the ibl-bake image readers
 # (tools/ibl-bake/fuzz) with clang++ -fsanitize=fuzzer,address,undefined and run it for RUNS
 # executions (default 100000), one job, on a seed corpus made from the real test EXRs and small
-# valid HDR/EXR/KTX2/PNG files (EXR in every compression, tiled, multi-part, Y/RY/BY). Not part of the default test run. Crash reproducers land in
+# valid HDR/EXR/KTX2/PNG files (EXR in every compression, tiled, multi-part, Y/RY/BY; KTX2 in
+# RGBA16F and the block formats BC6H / ASTC 4x4 / 6x6, plain and Zstandard-supercompressed).
+# Not part of the default test run. Crash reproducers land in
 # build/fuzz/artifacts/; copy them to tools/ibl-bake/tests/data/fuzz-<name> as regression
 # inputs once fixed. OpenEXR is Debian's prebuilt library, not instrumented: libFuzzer's coverage
 # and the sanitizers see our code (header pre-scan, stream, conversions) and stb; run valgrind on
@@ -14,9 +16,9 @@ SRC=$ROOT/tools/ibl-bake
 OUT=$ROOT/build/fuzz
 CXX=${CXX_FUZZ:-clang++}
 mkdir -p "$OUT/corpus" "$OUT/artifacts" "$OUT/seeds"
-COMMON=(-std=c++20 -g -O1 -fno-omit-frame-pointer -I"$SRC" -isystem /usr/include/stb -isystem /usr/include/OpenEXR -isystem /usr/include/Imath)
-LIBS=(-lOpenEXR -lIex -lImath)
-IO=("$SRC/io/image_common.cpp" "$SRC/io/image_hdr.cpp" "$SRC/io/image_exr.cpp" "$SRC/io/image_png.cpp" "$SRC/io/ktx2.cpp")
+COMMON=(-std=c++20 -g -O1 -fno-omit-frame-pointer -DASTCENC_DYNAMIC_LIBRARY -I"$SRC" -I"$ROOT/include" -isystem /usr/include/stb -isystem /usr/include/OpenEXR -isystem /usr/include/Imath)
+LIBS=(-lOpenEXR -lIex -lImath -lastcenc -lzstd)
+IO=("$SRC/io/image_common.cpp" "$SRC/io/image_hdr.cpp" "$SRC/io/image_exr.cpp" "$SRC/io/image_png.cpp" "$SRC/io/ktx2.cpp" "$SRC/io/block_codec.cpp")
 SAN=(-fsanitize=address,undefined -fno-sanitize-recover=undefined)
 
 echo "== building (clang: $($CXX --version | head -1))"
