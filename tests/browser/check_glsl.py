@@ -12,7 +12,7 @@ repo = os.path.join(here, "..", "..")
 glslang = sys.argv[1] if len(sys.argv) > 1 else "glslangValidator"
 lib = "".join(open(os.path.join(repo, "include", "ibl", "glsl", f)).read() + "\n"
               for f in ("ibl_common.glsl", "ibl_lookup.glsl", "ibl_sh.glsl", "ibl_shade.glsl", "ibl_runtime.glsl",
-                        "ibl_prefilter.glsl"))
+                        "ibl_prefilter.glsl", "ibl_local_probe.glsl"))
 es = "#version 300 es\nprecision highp float;\nprecision highp int;\nprecision highp samplerCube;\nprecision highp sampler2D;\n"
 cases = [("ES 3.00, every function", es, "tests/browser/glsl_check_main.glsl"),
          ("4.50, every function", "#version 450\n", "tests/browser/glsl_check_main.glsl"),

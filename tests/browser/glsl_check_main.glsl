@@ -58,5 +58,13 @@ void main() {
     ibl_cube_face_st(u_l, pf_face, pf_s, pf_t);
     vec3 pf = ibl_prefilter_texel(u_taps_a, u_taps_b, u_taps, 1.0, u_n) + ibl_cube_texel_direction(pf_face, 1, 2, 8) +
               ibl_packed_texel(u_taps_a, 3).xyz * (pf_s + pf_t);
-    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so + pf, 1.0);
+    ibl_probe_box pb = ibl_probe_box_axis_aligned(vec3(-2.0), vec3(3.0));
+    ibl_parallax_lookup pl = ibl_parallax_box(pb, vec3(0.5), u_n, u_l);
+    ibl_parallax_lookup ps = ibl_parallax_sphere(vec3(0.0), 4.0, vec3(0.5), u_n, u_l);
+    vec4 contrib;
+    float fb = ibl_blend_probe_weights4(vec4(ibl_influence_box(pb, 0.5, u_n), ibl_influence_sphere(vec3(0.0), 4.0, 0.5, u_n), 0.5, 0.25),
+                                        ivec4(1, 0, 0, 2), 4, contrib);
+    vec3 lp = pl.direction + ps.direction * ibl_corrected_roughness(u_r, pl.d_shading, pl.d_probe) +
+              vec3(ibl_proxy_exit_sphere(vec3(0.0), 2.0, u_n, u_l) + fb + contrib.x + ps.d_probe);
+    o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so + pf + lp, 1.0);
 }

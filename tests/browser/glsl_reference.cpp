@@ -18,6 +18,7 @@
 #include <ibl/env/cube_geometry.hpp>
 #include <ibl/env/cubemap.hpp>
 #include <ibl/reference/occluded_specular.hpp>
+#include <ibl/runtime/local_probe.hpp>
 #include <ibl/runtime/lookup.hpp>
 #include <ibl/runtime/specular_occlusion.hpp>
 #include <ibl/runtime/specular_models.hpp>
@@ -642,7 +643,30 @@ v4 runtime_row(int j, int i) {
     return v4(0.0f);
 }
 
+// ---- the local-probe rows (tools/viewer/numeric.frag.glsl: probe_room, probe_point, probe_dir) ----
+ibl::probe_box<float> probe_room() { return ibl::probe_box<float>::axis_aligned(v3(-2.0f, -1.0f, -1.5f), v3(2.5f, 1.5f, 3.0f)); }
+v3 probe_point(int i) { return v3(float(i % 8) * 0.5f - 1.75f, float(i / 8) * 0.25f - 0.875f, float(i % 5) * 0.5f - 1.0f); }
+v3 probe_dir(int i) { return dir_of(i) * v3(i % 2 == 1 ? 1.0f : -1.0f, i % 3 == 0 ? -1.0f : 1.0f, 1.0f); }
+
+v4 local_probe_row(int j, int i) {
+    const float x = u64(i);
+    const ibl::probe_box<float> b = probe_room();
+    const v3 c(0.25f, 0.5f, -0.25f), p = probe_point(i), r = probe_dir(i);
+    if (j == 32) {
+        const ibl::parallax_lookup<float> l = ibl::parallax_correct(b, c, p, r);
+        return {l.direction.x, l.direction.y, l.direction.z, l.d_shading};
+    }
+    const ibl::probe_sphere<float> sph{v3(0.25f, 0.0f, 0.5f), 3.0f};
+    const ibl::parallax_lookup<float> s = ibl::parallax_correct(sph, c, p, r);
+    const float w[4] = {ibl::influence_weight(b, 0.5f, p), ibl::influence_weight(sph, 0.75f, p), x, 1.0f - x};
+    const int pr[4] = {i % 3, 1, 0, i % 2};
+    float contrib[4];
+    const float fb = ibl::blend_probe_weights(w, pr, 4, contrib);
+    return {ibl::corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe, fb, contrib[0] + 2.0f * contrib[1]};
+}
+
 v4 row_value(int j, int i) {
+    if (j >= 32) return local_probe_row(j, i);
     const float x = u64(i);
     if (j == 0) {
         const auto t = ibl::specular_lookup_taps(x, 6, desc_default());
@@ -955,6 +979,8 @@ int main(int argc, char** argv) {
         {"so table (8^3 R32F)", 1e-5, 0.0},
         {"so bent", 1e-5, 0.0},
         {"so filter probe (texel exact)", 1e-5, 1e-6},
+        {"local probe: parallax", 1e-5, 1e-6},
+        {"local probe: roughness, influence, blend", 1e-5, 1e-6},
     };
     const int n_rows = int(sizeof(rows) / sizeof(rows[0]));
     std::printf("{\"width\": %d, \"height\": %d, \"rows\": [", width, n_rows);

@@ -1,5 +1,5 @@
 // tools/viewer/numeric.frag.glsl — evaluates the library's GLSL functions on a fixed grid of
-// inputs: output pixel (i, j) of a 64 x 28 RGBA32F target holds case i of row j. The same grid
+// inputs: output pixel (i, j) of a 64 x 34 RGBA32F target holds case i of row j. The same grid
 // evaluated by the C++ library is tests/browser/glsl_reference.cpp; the two must agree (the
 // inputs are built only from exact operations: multiples of 1/64, small integers). The runtime
 // rows read the reference's fixtures (glsl_reference --fixtures, uploaded by the page): an 8^2
@@ -146,7 +146,29 @@ vec4 runtime_row(int j, int i) {
     return vec4(0.0);
 }
 
+// ---- the local-probe rows (glsl_reference.cpp: probe_room, probe_point, probe_dir) ----
+ibl_probe_box probe_room() { return ibl_probe_box_axis_aligned(vec3(-2.0, -1.0, -1.5), vec3(2.5, 1.5, 3.0)); }
+vec3 probe_point(int i) { return vec3(float(i % 8) * 0.5 - 1.75, float(i / 8) * 0.25 - 0.875, float(i % 5) * 0.5 - 1.0); }
+vec3 probe_dir(int i) { return dir_of(i) * vec3(i % 2 == 1 ? 1.0 : -1.0, i % 3 == 0 ? -1.0 : 1.0, 1.0); }
+
+vec4 local_probe_row(int j, int i) {
+    float x = u64(i);
+    ibl_probe_box b = probe_room();
+    vec3 c = vec3(0.25, 0.5, -0.25), p = probe_point(i), r = probe_dir(i);
+    if (j == 32) {
+        ibl_parallax_lookup l = ibl_parallax_box(b, c, p, r);
+        return vec4(l.direction, l.d_shading);
+    }
+    ibl_parallax_lookup s = ibl_parallax_sphere(vec3(0.25, 0.0, 0.5), 3.0, c, p, r);
+    vec4 contrib;
+    float fb = ibl_blend_probe_weights4(vec4(ibl_influence_box(b, 0.5, p), ibl_influence_sphere(vec3(0.25, 0.0, 0.5), 3.0, 0.75, p), x,
+                                             1.0 - x),
+                                        ivec4(i % 3, 1, 0, i % 2), 4, contrib);
+    return vec4(ibl_corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe, fb, contrib.x + 2.0 * contrib.y);
+}
+
 vec4 row_value(int j, int i) {
+    if (j >= 32) return local_probe_row(j, i);
     if (j >= 18) return runtime_row(j, i);
     float x = u64(i);
     if (j == 0) { // default taps in 6 levels

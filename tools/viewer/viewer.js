@@ -179,7 +179,8 @@ async function fetchText(url) {
 
 async function libraryGlsl() {
     const parts = [];
-    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl', 'ibl_runtime.glsl', 'ibl_prefilter.glsl']) parts.push(await fetchText(glslBase + f));
+    for (const f of ['ibl_common.glsl', 'ibl_lookup.glsl', 'ibl_sh.glsl', 'ibl_shade.glsl', 'ibl_runtime.glsl', 'ibl_prefilter.glsl',
+                     'ibl_local_probe.glsl']) parts.push(await fetchText(glslBase + f));
     return parts.join('\n');
 }
 
@@ -587,7 +588,7 @@ async function runNumericTest() {
     if (!gl) throw new Error('WebGL2 is not available');
     if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('EXT_color_buffer_float is needed to read float results');
     const program = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('numeric.frag.glsl')));
-    const W = 64, H = 32;
+    const W = 64, H = 34;
     // The runtime rows' fixtures (glsl_reference --fixtures): an RGBA32F chain, two RGBA32F tables,
     // an R32F 3-D occlusion table.
     if (!gl.getExtension('OES_texture_float_linear')) throw new Error('OES_texture_float_linear is needed to filter the fixtures');

@@ -1,0 +1,128 @@
+// ibl_local_probe.glsl — local reflection probes (GLSL ES 3.00 / 4.50): the GLSL mirror of
+// ibl/runtime/local_probe.hpp (its header comment derives everything): ray-proxy exits for boxes
+// (axis-aligned or oriented) and spheres, the parallax-corrected lookup direction, the
+// distance-based roughness, influence weights and the priority blend of up to four probes.
+// Needs nothing else; the C++ and GLSL answers agree within float rounding (numeric grid rows
+// "local probe: parallax" and "local probe: roughness, influence, blend" of the browser test).
+
+#ifndef IBL_GLSL_LOCAL_PROBE
+#define IBL_GLSL_LOCAL_PROBE 1
+
+struct ibl_probe_box {
+    vec3 center;
+    vec3 half_extent;
+    vec3 axis0, axis1, axis2; // orthonormal world directions of the box's x, y, z
+};
+
+ibl_probe_box ibl_probe_box_axis_aligned(vec3 lo, vec3 hi) {
+    return ibl_probe_box((lo + hi) * 0.5, (hi - lo) * 0.5, vec3(1.0, 0.0, 0.0), vec3(0.0, 1.0, 0.0), vec3(0.0, 0.0, 1.0));
+}
+
+vec3 ibl_probe_box_local(ibl_probe_box b, vec3 v) { return vec3(dot(v, b.axis0), dot(v, b.axis1), dot(v, b.axis2)); }
+
+// Distance along normalize(r) from p to where the ray leaves the box; -1 without such an exit.
+float ibl_proxy_exit_box(ibl_probe_box b, vec3 p, vec3 r) {
+    float len2 = dot(r, r);
+    if (!(len2 > 0.0)) return -1.0;
+    vec3 o = ibl_probe_box_local(b, p - b.center), d = ibl_probe_box_local(b, r * inversesqrt(len2));
+    float t_near = -3.0e38, t_far = 3.0e38;
+    for (int k = 0; k < 3; ++k) {
+        if (d[k] == 0.0) {
+            if (abs(o[k]) > b.half_extent[k]) return -1.0;
+            continue;
+        }
+        float inv = 1.0 / d[k];
+        float a = (-b.half_extent[k] - o[k]) * inv, c = (b.half_extent[k] - o[k]) * inv;
+        t_near = max(t_near, min(a, c));
+        t_far = min(t_far, max(a, c));
+    }
+    return (t_near <= t_far && t_far > 0.0) ? t_far : -1.0;
+}
+
+float ibl_proxy_exit_sphere(vec3 center, float radius, vec3 p, vec3 r) {
+    float len2 = dot(r, r);
+    if (!(len2 > 0.0)) return -1.0;
+    vec3 ru = r * inversesqrt(len2), o = p - center;
+    float b = dot(o, ru), c = dot(o, o) - radius * radius, disc = b * b - c;
+    if (!(disc >= 0.0)) return -1.0;
+    float t_far = -b + sqrt(disc);
+    return t_far > 0.0 ? t_far : -1.0;
+}
+
+struct ibl_parallax_lookup {
+    vec3 direction; // where to read the probe captured at c
+    float d_shading; // from p to the hit (0 without one)
+    float d_probe;   // from c to the hit (0 without one)
+};
+
+// The lookup for the exit distance t along normalize(r) from p (t <= 0: no correction, r itself).
+ibl_parallax_lookup ibl_parallax_from_exit(vec3 c, vec3 p, vec3 r, float t) {
+    float len2 = dot(r, r);
+    if (!(len2 > 0.0)) return ibl_parallax_lookup(r, 0.0, 0.0);
+    vec3 ru = r * inversesqrt(len2);
+    if (!(t > 0.0)) return ibl_parallax_lookup(ru, 0.0, 0.0);
+    vec3 d = (p - c) + t * ru;
+    float len = length(d);
+    if (!(len > 0.0)) return ibl_parallax_lookup(ru, 0.0, 0.0);
+    return ibl_parallax_lookup(d / len, t, len);
+}
+
+ibl_parallax_lookup ibl_parallax_box(ibl_probe_box b, vec3 c, vec3 p, vec3 r) {
+    return ibl_parallax_from_exit(c, p, r, ibl_proxy_exit_box(b, p, r));
+}
+
+ibl_parallax_lookup ibl_parallax_sphere(vec3 center, float radius, vec3 c, vec3 p, vec3 r) {
+    return ibl_parallax_from_exit(c, p, r, ibl_proxy_exit_sphere(center, radius, p, r));
+}
+
+// Distance-based roughness: r' = sqrt(clamp(r^2 d_shading / d_probe, 0, 1)); r without a hit.
+float ibl_corrected_roughness(float roughness, float d_shading, float d_probe) {
+    float r = clamp(roughness, 0.0, 1.0);
+    if (!(d_shading > 0.0) || !(d_probe > 0.0)) return r;
+    return sqrt(clamp(r * r * (d_shading / d_probe), 0.0, 1.0));
+}
+
+// Influence weights: distance to the boundary inside the volume over the fade width, in [0, 1].
+float ibl_influence_box(ibl_probe_box b, float fade, vec3 p) {
+    vec3 d = b.half_extent - abs(ibl_probe_box_local(b, p - b.center));
+    return clamp(min(d.x, min(d.y, d.z)) / max(fade, 1.17549435e-38), 0.0, 1.0);
+}
+
+float ibl_influence_sphere(vec3 center, float radius, float fade, vec3 p) {
+    return clamp((radius - length(p - center)) / max(fade, 1.17549435e-38), 0.0, 1.0);
+}
+
+// The priority blend of the first n (<= 4) probes: contributions in `contrib`, the distant
+// environment's share returned; higher priority first, equal priorities share by weight.
+float ibl_blend_probe_weights4(vec4 weights, ivec4 priority, int n, out vec4 contrib) {
+    contrib = vec4(0.0);
+    float remaining = 1.0;
+    bool have_prev = false;
+    int prev = 0;
+    for (int pass = 0; pass < 4; ++pass) {
+        bool found = false;
+        int level = 0;
+        for (int i = 0; i < 4; ++i)
+            if (i < n && (!have_prev || priority[i] < prev) && (!found || priority[i] > level)) {
+                level = priority[i];
+                found = true;
+            }
+        if (!found) break;
+        float sum = 0.0;
+        for (int i = 0; i < 4; ++i)
+            if (i < n && priority[i] == level) sum += clamp(weights[i], 0.0, 1.0);
+        float scale = remaining / max(sum, 1.0);
+        float used = 0.0;
+        for (int i = 0; i < 4; ++i)
+            if (i < n && priority[i] == level) {
+                contrib[i] = clamp(weights[i], 0.0, 1.0) * scale;
+                used += contrib[i];
+            }
+        remaining = max(remaining - used, 0.0);
+        have_prev = true;
+        prev = level;
+    }
+    return remaining;
+}
+
+#endif // IBL_GLSL_LOCAL_PROBE

@@ -1,0 +1,218 @@
+// tests/test_local_probe.cpp — runtime/local_probe.hpp: ray-proxy exits against brute-force
+// marching and closed forms (axis-aligned and oriented boxes, spheres), the parallax-corrected
+// direction against the geometry it stands for (the ray from the capture point along it meets the
+// proxy where the reflection ray does), the distance-based roughness' limits and monotonicity,
+// influence weights (range, zero outside, Lipschitz bound 1 / fade), and the blend (contributions
+// and fallback sum to one, priorities, continuity along paths).
+
+#include <doctest/doctest.h>
+
+#include <ibl/runtime/local_probe.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <random>
+#include <vector>
+
+namespace {
+
+using dvec3 = ibl::vec3<double>;
+
+dvec3 random_unit(std::mt19937_64& rng) {
+    std::normal_distribution<double> n(0.0, 1.0);
+    for (;;) {
+        const dvec3 v(n(rng), n(rng), n(rng));
+        const double l = glm::length(v);
+        if (l > 1e-6) return v / l;
+    }
+}
+
+ibl::probe_box<double> rotated_box(std::mt19937_64& rng) {
+    ibl::probe_box<double> b;
+    b.center = dvec3(0.3, -0.2, 0.5);
+    b.half = dvec3(2.0, 1.2, 3.1);
+    const dvec3 a = random_unit(rng);
+    dvec3 t = glm::cross(a, dvec3(0.0, 1.0, 0.0));
+    if (glm::length(t) < 1e-3) t = glm::cross(a, dvec3(1.0, 0.0, 0.0));
+    t = glm::normalize(t);
+    b.axis[0] = a;
+    b.axis[1] = t;
+    b.axis[2] = glm::cross(a, t);
+    return b;
+}
+
+bool inside(const ibl::probe_box<double>& b, const dvec3& p) {
+    const dvec3 o = b.to_local(p);
+    return std::fabs(o.x) <= b.half.x && std::fabs(o.y) <= b.half.y && std::fabs(o.z) <= b.half.z;
+}
+
+} // namespace
+
+TEST_CASE("local probe: box exit distance lands on the boundary, the ray stays inside before it") {
+    std::mt19937_64 rng(7);
+    std::uniform_real_distribution<double> u(-0.99, 0.99);
+    for (int k = 0; k < 2000; ++k) {
+        const ibl::probe_box<double> b = k % 2 ? rotated_box(rng) : ibl::probe_box<double>::axis_aligned(dvec3(-1, -2, -3), dvec3(4, 1, 2));
+        const dvec3 p = b.center + u(rng) * b.half.x * b.axis[0] + u(rng) * b.half.y * b.axis[1] + u(rng) * b.half.z * b.axis[2];
+        const dvec3 r = random_unit(rng);
+        const double t = ibl::proxy_exit_distance(b, p, r * 3.0); // R need not be unit
+        REQUIRE(t > 0.0);
+        const dvec3 o = b.to_local(p + t * r);
+        const double m = std::max({std::fabs(o.x) / b.half.x, std::fabs(o.y) / b.half.y, std::fabs(o.z) / b.half.z});
+        CHECK(m == doctest::Approx(1.0).epsilon(1e-12));
+        // brute force: marching finds the last inside point within the step
+        double s = 0.0;
+        const double step = 1e-3;
+        while (inside(b, p + (s + step) * r)) s += step;
+        CHECK(std::fabs(s - t) <= step + 1e-9);
+    }
+}
+
+TEST_CASE("local probe: an oriented box equals the axis-aligned box in its own frame; spheres by the closed form") {
+    std::mt19937_64 rng(11);
+    for (int k = 0; k < 500; ++k) {
+        const ibl::probe_box<double> b = rotated_box(rng);
+        const ibl::probe_box<double> local = ibl::probe_box<double>::axis_aligned(-b.half, b.half);
+        const dvec3 p = b.center + 0.5 * random_unit(rng), r = random_unit(rng);
+        CHECK(ibl::proxy_exit_distance(b, p, r) == doctest::Approx(ibl::proxy_exit_distance(local, b.to_local(p), b.direction_to_local(r))).epsilon(1e-12));
+        const ibl::probe_sphere<double> s{dvec3(1.0, 2.0, -1.0), 2.5};
+        const dvec3 q = s.center + 2.4 * std::pow(std::uniform_real_distribution<double>(0, 1)(rng), 1.0 / 3.0) * random_unit(rng);
+        const double t = ibl::proxy_exit_distance(s, q, r);
+        REQUIRE(t > 0.0);
+        CHECK(glm::length(q + t * r - s.center) == doctest::Approx(2.5).epsilon(1e-12));
+    }
+}
+
+TEST_CASE("local probe: no correction outside and behind, for zero and NaN directions") {
+    const auto b = ibl::probe_box<double>::axis_aligned(dvec3(-1), dvec3(1));
+    const ibl::probe_sphere<double> s{dvec3(0.0), 1.0};
+    CHECK(ibl::proxy_exit_distance(b, dvec3(3, 0, 0), dvec3(1, 0, 0)) == -1.0); // box behind
+    CHECK(ibl::proxy_exit_distance(b, dvec3(3, 3, 0), dvec3(0, 0, 1)) == -1.0); // missed, parallel
+    CHECK(ibl::proxy_exit_distance(s, dvec3(3, 0, 0), dvec3(0, 1, 0)) == -1.0);
+    CHECK(ibl::proxy_exit_distance(b, dvec3(3, 0, 0), dvec3(-1, 0, 0)) == doctest::Approx(4.0)); // outside, facing: the far side
+    CHECK(ibl::proxy_exit_distance(b, dvec3(0.0), dvec3(0.0)) == -1.0);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    CHECK(ibl::proxy_exit_distance(s, dvec3(0.0), dvec3(nan, 0, 0)) == -1.0);
+    const dvec3 r(0.0, 0.0, 2.0);
+    const ibl::parallax_lookup<double> l = ibl::parallax_correct(b, dvec3(0.5), dvec3(5, 5, 5), r);
+    CHECK_FALSE(l.hit);
+    CHECK(l.direction == dvec3(0, 0, 1));
+}
+
+TEST_CASE("local probe: the corrected direction sees the proxy where the reflection ray meets it") {
+    std::mt19937_64 rng(3);
+    std::uniform_real_distribution<double> u(-0.95, 0.95);
+    const auto room = ibl::probe_box<double>::axis_aligned(dvec3(-4, 0, -3), dvec3(4, 3, 5));
+    const dvec3 c(0.5, 1.5, 0.2); // the capture point
+    for (int k = 0; k < 1000; ++k) {
+        const dvec3 p = room.center + dvec3(u(rng) * room.half.x, u(rng) * room.half.y, u(rng) * room.half.z);
+        const dvec3 r = random_unit(rng);
+        const ibl::parallax_lookup<double> l = ibl::parallax_correct(room, c, p, r);
+        REQUIRE(l.hit);
+        const dvec3 hit = p + l.d_shading * r;
+        const double tc = ibl::proxy_exit_distance(room, c, l.direction);
+        CHECK(glm::length(c + tc * l.direction - hit) < 1e-9);
+        CHECK(l.d_probe == doctest::Approx(tc).epsilon(1e-12));
+        CHECK(glm::length(l.direction) == doctest::Approx(1.0).epsilon(1e-14));
+    }
+    // from the capture point itself the lookup is the reflection direction
+    for (int k = 0; k < 100; ++k) {
+        const dvec3 r = random_unit(rng);
+        CHECK(glm::length(ibl::parallax_direction(room, c, c, r) - r) < 1e-14);
+    }
+}
+
+TEST_CASE("local probe: distance-based roughness") {
+    CHECK(ibl::corrected_roughness(0.4, 2.0, 2.0) == doctest::Approx(0.4).epsilon(1e-15));
+    CHECK(ibl::corrected_roughness(0.4, 1.0, 4.0) == doctest::Approx(0.2).epsilon(1e-15)); // alpha / 4
+    CHECK(ibl::corrected_roughness(0.4, 4.0, 1.0) == doctest::Approx(0.8).epsilon(1e-15)); // alpha x 4
+    CHECK(ibl::corrected_roughness(0.9, 10.0, 1.0) == 1.0);                                // clamped
+    CHECK(ibl::corrected_roughness(0.0, 3.0, 1.0) == 0.0);                                 // a mirror stays one
+    CHECK(ibl::corrected_roughness(0.5, 0.0, 1.0) == 0.5);                                 // no hit: unchanged
+    CHECK(ibl::corrected_roughness(0.5, 1.0, std::numeric_limits<double>::infinity()) == 0.5);
+    CHECK(ibl::corrected_roughness(1.5, 1.0, 1.0) == 1.0);
+    double prev = 0.0;
+    for (int k = 1; k <= 50; ++k) { // monotone in d_shading / d_probe
+        const double r = ibl::corrected_roughness(0.3, 0.1 * k, 2.0);
+        CHECK(r >= prev);
+        prev = r;
+    }
+}
+
+TEST_CASE("local probe: influence weights lie in [0, 1], vanish outside and change by at most |dP| / fade") {
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-6.0, 6.0);
+    const ibl::probe_box<double> box = rotated_box(rng);
+    const ibl::probe_sphere<double> sph{dvec3(1.0, 0.0, 0.0), 3.0};
+    const double fade = 0.5;
+    for (int k = 0; k < 20000; ++k) {
+        const dvec3 p(u(rng), u(rng), u(rng));
+        const dvec3 q = p + 0.05 * random_unit(rng);
+        const double wb = ibl::influence_weight(box, fade, p), ws = ibl::influence_weight(sph, fade, p);
+        CHECK(wb >= 0.0);
+        CHECK(wb <= 1.0);
+        if (!inside(box, p)) CHECK(wb == 0.0);
+        if (glm::length(p - sph.center) >= 3.0) CHECK(ws == 0.0);
+        CHECK(std::fabs(ibl::influence_weight(box, fade, q) - wb) <= glm::length(q - p) / fade + 1e-12);
+        CHECK(std::fabs(ibl::influence_weight(sph, fade, q) - ws) <= glm::length(q - p) / fade + 1e-12);
+    }
+    CHECK(ibl::influence_weight(sph, fade, sph.center) == 1.0);
+    CHECK(ibl::influence_weight(sph, 0.0, dvec3(1.0, 2.999, 0.0)) == 1.0); // no fade: a hard edge
+}
+
+TEST_CASE("local probe: blend contributions and the fallback sum to one; priorities; continuity") {
+    std::mt19937_64 rng(9);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    for (int k = 0; k < 5000; ++k) {
+        const std::size_t n = 1 + std::size_t(k % 6);
+        double w[6], c[6];
+        int pr[6];
+        for (std::size_t i = 0; i < n; ++i) w[i] = k % 3 ? u(rng) : std::round(u(rng)), pr[i] = int(u(rng) * 3.0);
+        const double fallback = ibl::blend_probe_weights(w, pr, n, c);
+        double sum = fallback;
+        for (std::size_t i = 0; i < n; ++i) {
+            CHECK(c[i] >= 0.0);
+            CHECK(c[i] <= w[i] + 1e-15);
+            sum += c[i];
+        }
+        CHECK(sum == doctest::Approx(1.0).epsilon(1e-14));
+        CHECK(fallback >= 0.0);
+    }
+    // a full-weight higher-priority probe takes everything; equal priorities share by weight
+    {
+        const double w[3] = {1.0, 1.0, 0.5};
+        const int pr[3] = {2, 1, 1};
+        double c[3];
+        CHECK(ibl::blend_probe_weights(w, pr, 3, c) == 0.0);
+        CHECK(c[0] == 1.0);
+        CHECK(c[1] == 0.0);
+        CHECK(c[2] == 0.0);
+        const int same[3] = {0, 0, 0};
+        CHECK(ibl::blend_probe_weights(w, same, 3, c) == 0.0);
+        CHECK(c[0] == doctest::Approx(0.4));
+        CHECK(c[2] == doctest::Approx(0.2));
+        const double low[2] = {0.3, 0.2};
+        CHECK(ibl::blend_probe_weights(low, same, 2, c) == doctest::Approx(0.5)); // the sky fills in
+    }
+    // two overlapping influence boxes walked across: every contribution moves by at most a bounded
+    // multiple of the step (no jumps at the boundaries)
+    const auto a = ibl::probe_box<double>::axis_aligned(dvec3(-4, -1, -1), dvec3(1, 1, 1));
+    const auto b = ibl::probe_box<double>::axis_aligned(dvec3(-1, -1, -1), dvec3(4, 1, 1));
+    const double fade = 0.5, step = 1e-3;
+    double prev[2] = {0, 0}, prev_f = 1.0;
+    for (int k = 0; k <= 10000; ++k) {
+        const dvec3 p(-5.0 + k * step, 0.1, 0.0);
+        const double w[2] = {ibl::influence_weight(a, fade, p), ibl::influence_weight(b, fade, p)};
+        const int pr[2] = {0, 0};
+        double c[2];
+        const double f = ibl::blend_probe_weights(w, pr, 2, c);
+        if (k > 0) {
+            CHECK(std::fabs(c[0] - prev[0]) <= 4.0 * step / fade);
+            CHECK(std::fabs(c[1] - prev[1]) <= 4.0 * step / fade);
+            CHECK(std::fabs(f - prev_f) <= 4.0 * step / fade);
+        }
+        prev[0] = c[0], prev[1] = c[1], prev_f = f;
+    }
+}
