@@ -16,6 +16,8 @@
 
 #include <ibl/bake/dfg.hpp>
 #include <ibl/bake/dfg_lut.hpp>
+#include <ibl/bake/dfg_multiscatter.hpp>
+#include <ibl/core/limits.hpp>
 #include <ibl/brdf/blinn_phong.hpp>
 #include <ibl/core/executor.hpp>
 
@@ -417,6 +419,49 @@ py::array_t<float> dfg_lut(long long size, py::object model, const std::string& 
     return out;
 }
 
+// ---- Monte Carlo DFG and the multiscatter energy terms (built-in models) ----------------------------
+
+builtin builtin_only(const char* fn, py::object model) {
+    const model_arg ma = parse_model(fn, model);
+    if (!ma.is_builtin)
+        throw py::type_error(std::string("ibl.") + fn + ": model must be a built-in model name (" + builtin_names +
+                             "); Python models are taken by ibl.dfg and ibl.dfg_lut");
+    return ma.b;
+}
+
+py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, py::object model, const std::string& sampling) {
+    const builtin b = builtin_only("dfg_mc", model);
+    if (samples < 1 || samples > (long long)ibl::limits::max_samples)
+        throw py::value_error("ibl.dfg_mc: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) + "], got " +
+                              std::to_string(samples));
+    bool vndf;
+    if (sampling == "ndf") vndf = false;
+    else if (sampling == "vndf") vndf = true;
+    else throw py::value_error("ibl.dfg_mc: sampling must be 'ndf' or 'vndf', got '" + sampling + "'");
+    const auto n = std::uint32_t(samples);
+    return map("dfg_mc", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 2, [&](auto tag) {
+        using T = decltype(tag);
+        return [b, n, vndf](const T* const* in, T* out) {
+            const ibl::vec2<T> v = with_builtin(b, [&](auto m) {
+                using M = decltype(m);
+                return vndf ? ibl::dfg_mc_vndf<M>(in[0][0], in[1][0], n) : ibl::dfg_mc<M>(in[0][0], in[1][0], n);
+            });
+            out[0] = v.x;
+            out[1] = v.y;
+        };
+    });
+}
+
+py::object dfg_albedo(py::object n_dot_v, py::object roughness, py::object model) {
+    const builtin b = builtin_only("dfg_albedo", model);
+    return map("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 1, [&](auto tag) {
+        using T = decltype(tag);
+        return [b](const T* const* in, T* out) {
+            *out = with_builtin(b, [&](auto m) { return ibl::dfg_albedo<decltype(m)>(in[0][0], in[1][0]); });
+        };
+    });
+}
+
 } // namespace
 
 void bind_dfg(py::module_& m) {
@@ -467,6 +512,27 @@ void bind_dfg(py::module_& m) {
         },
         py::arg("size"), py::arg("layout") = "uniform",
         "(n_dot_v, roughness): the texel values of a table's columns and rows in a layout.");
+    m.def("dfg_mc", &dfg_mc, py::arg("n_dot_v"), py::arg("roughness"), py::arg("samples") = 1024,
+          py::arg("model") = "ggx_height_correlated", py::kw_only(), py::arg("sampling") = "ndf",
+          "Split-sum DFG terms (A, B) by Monte Carlo with `samples` Hammersley points: array (..., 2) over the\n"
+          "broadcast shape of n_dot_v and roughness (in [0, 1]). sampling 'ndf': GGX NDF importance sampling\n"
+          "(ibl::dfg_mc, the estimator of Karis 2013); 'vndf': visible normals (ibl::dfg_mc_vndf, Heitz /\n"
+          "Dupuy). Samples below the horizon count as zeros. Built-in models only.");
+    m.def("dfg_albedo", &dfg_albedo, py::arg("n_dot_v"), py::arg("roughness"), py::arg("model") = "ggx_height_correlated",
+          "The directional albedo E = A + B of a built-in model by the deterministic quadrature\n"
+          "(ibl::dfg_albedo, bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what\n"
+          "multiple scattering restores.");
+    m.def(
+        "dfg_energy_compensation",
+        [](py::object albedo) {
+            return map("dfg_energy_compensation", {{albedo, 1, "albedo", true}}, 1, [](auto tag) {
+                using T = decltype(tag);
+                return [](const T* const* in, T* out) { *out = ibl::dfg_energy_compensation(in[0][0]); };
+            });
+        },
+        py::arg("albedo"),
+        "Turquin's energy compensation k = (1 - E) / E of an albedo E in [0, 1] (E floored at the smallest\n"
+        "normal float): the third channel of dfg_lut(multiscatter=True).");
     m.attr("builtin_models") = py::make_tuple("ggx_height_correlated", "ggx_schlick_ibl", "blinn_phong");
 }
 

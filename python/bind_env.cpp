@@ -9,7 +9,10 @@
 #include <ibl/core/executor.hpp>
 #include <ibl/core/limits.hpp>
 #include <ibl/env/cubemap.hpp>
+#include <ibl/env/sun_extract.hpp>
+#include <ibl/reference/env_importance.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/reference/radiance.hpp>
 #include <ibl/sh.hpp>
 
 #include <cmath>
@@ -219,6 +222,119 @@ py::object reference_ld(py::object cube, py::object dirs, py::object roughness, 
     return out;
 }
 
+py::object extract_sun(py::object cube, double threshold_over_median, double threshold_over_peak, double max_solid_angle,
+                       double min_share, unsigned threads) {
+    auto check = [](double v, const char* name, bool positive) {
+        if (!std::isfinite(v) || v < 0.0 || (positive && v <= 0.0))
+            throw py::value_error(std::string("ibl.extract_sun: ") + name + " must be finite and " +
+                                  (positive ? "> 0" : ">= 0") + ", got " + std::to_string(v));
+    };
+    check(threshold_over_median, "threshold_over_median", false);
+    check(threshold_over_peak, "threshold_over_peak", false);
+    check(max_solid_angle, "max_solid_angle", true);
+    check(min_share, "min_share", false);
+    ibl::sun_extract_options opt;
+    opt.threshold_over_median = threshold_over_median;
+    opt.threshold_over_peak = threshold_over_peak;
+    opt.max_solid_angle = max_solid_angle;
+    opt.min_share = min_share;
+    ibl::cubemap<float> env = to_cubemap("extract_sun", cube, threads);
+    ibl::sun_extraction<float> sun;
+    {
+        py::gil_scoped_release release;
+        sun = ibl::extract_sun_in_place(env, opt, ibl::thread_executor{threads});
+    }
+    if (sun.status != ibl::sun_status::found) return py::none();
+    auto v3 = [](const ibl::vec3<float>& v) {
+        py::array_t<double> a(py::ssize_t(3));
+        a.mutable_data()[0] = double(v.x);
+        a.mutable_data()[1] = double(v.y);
+        a.mutable_data()[2] = double(v.z);
+        return a;
+    };
+    py::dict light;
+    light["direction"] = v3(sun.direction);
+    light["solid_angle"] = double(sun.solid_angle);
+    light["angular_radius"] = double(sun.angular_radius);
+    light["radiance"] = v3(sun.radiance);
+    light["irradiance"] = v3(sun.irradiance);
+    light["region_solid_angle"] = double(sun.region_solid_angle);
+    light["region_texels"] = sun.region_texels;
+    light["share"] = sun.share;
+    return py::make_tuple(light, level_array(env, 0));
+}
+
+py::dict reference_radiance(py::object cube, py::object n, py::object v, py::object base_color, py::object metallic,
+                            py::object roughness, long long samples, long long batches, std::uint32_t seed,
+                            const std::string& strategy, const std::string& diffuse, double dielectric_f0, unsigned threads) {
+    const char* fn = "reference_radiance";
+    ibl::radiance_reference_options opt;
+    if (samples < 1 || samples > (long long)ibl::limits::max_samples)
+        throw py::value_error("ibl.reference_radiance: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) +
+                              "], got " + std::to_string(samples));
+    if (batches < 2 || batches > (long long)ibl::limits::max_batches)
+        throw py::value_error("ibl.reference_radiance: batches must lie in [2, " + std::to_string(ibl::limits::max_batches) +
+                              "], got " + std::to_string(batches));
+    opt.samples = std::uint32_t(samples);
+    opt.batches = std::uint32_t(batches);
+    opt.seed = seed;
+    if (strategy == "mis") opt.strategy = ibl::radiance_strategy::mis;
+    else if (strategy == "brdf") opt.strategy = ibl::radiance_strategy::brdf;
+    else if (strategy == "env") opt.strategy = ibl::radiance_strategy::env;
+    else throw py::value_error("ibl.reference_radiance: strategy must be 'mis', 'brdf' or 'env', got '" + strategy + "'");
+    ibl::diffuse_weighting dw;
+    if (diffuse == "lambert") dw = ibl::diffuse_weighting::lambert;
+    else if (diffuse == "one_minus_fresnel_roughness") dw = ibl::diffuse_weighting::one_minus_fresnel_roughness;
+    else throw py::value_error("ibl.reference_radiance: diffuse must be 'lambert' or 'one_minus_fresnel_roughness', got '" +
+                               diffuse + "'");
+    if (!(dielectric_f0 >= 0.0 && dielectric_f0 <= 1.0))
+        throw py::value_error("ibl.reference_radiance: dielectric_f0 must lie in [0, 1], got " + std::to_string(dielectric_f0));
+    broadcast_args<double> b = broadcast<double>(fn, {{n, 3, "n"},
+                                                      {v, 3, "v"},
+                                                      {base_color, 3, "base_color", true},
+                                                      {metallic, 1, "metallic", true},
+                                                      {roughness, 1, "roughness", true}});
+    for (int k = 0; k < 2; ++k)
+        for (std::size_t i = 0; i < b.count; ++i) {
+            const double* d = b.data[std::size_t(k)] + 3 * i;
+            const double q = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+            if (!(q > 0.0) || !std::isfinite(q))
+                throw py::value_error(std::string("ibl.reference_radiance: ") + (k == 0 ? "n" : "v") +
+                                      " must be non-zero finite vectors (flat element " + std::to_string(i) + ")");
+        }
+    const ibl::cubemap<float> env = to_cubemap(fn, cube, threads);
+    std::optional<ibl::cube_env_distribution> dist;
+    std::vector<double> out(b.count * 12);
+    {
+        py::gil_scoped_release release;
+        if (opt.strategy != ibl::radiance_strategy::brdf) dist.emplace(env);
+        ibl::thread_executor{threads}(b.count, [&](std::size_t begin, std::size_t end) {
+            for (std::size_t i = begin; i < end; ++i) {
+                auto vec = [&](int k) {
+                    const double* d = b.data[std::size_t(k)] + 3 * i;
+                    return ibl::vec3<double>(d[0], d[1], d[2]);
+                };
+                const ibl::reference_material mat =
+                    ibl::make_reference_material(vec(2), b.data[3][i], b.data[4][i], dw, dielectric_f0);
+                const ibl::radiance_estimate e = ibl::reference_radiance(env, dist ? &*dist : nullptr, glm::normalize(vec(0)),
+                                                                         glm::normalize(vec(1)), mat, opt);
+                const ibl::vec3<double>* parts[4] = {&e.value, &e.diffuse, &e.specular, &e.std_error};
+                for (int p = 0; p < 4; ++p)
+                    for (int c = 0; c < 3; ++c) out[(std::size_t(p) * b.count + i) * 3 + std::size_t(c)] = (*parts[p])[c];
+            }
+        });
+    }
+    py::dict result;
+    const char* names[4] = {"value", "diffuse", "specular", "std_error"};
+    for (std::size_t p = 0; p < 4; ++p) {
+        py::array_t<double> a = make_output<double>(b.shape, 3);
+        std::copy(out.begin() + std::ptrdiff_t(p * b.count * 3), out.begin() + std::ptrdiff_t((p + 1) * b.count * 3),
+                  a.mutable_data());
+        result[names[p]] = a;
+    }
+    return result;
+}
+
 } // namespace
 
 void bind_env(py::module_& m) {
@@ -245,6 +361,29 @@ void bind_env(py::module_& m) {
           py::kw_only(), py::arg("weight") = "n_dot_l", py::arg("threads") = 0u,
           "Converged LD at directions (..., 3) and roughness (broadcast) by GGX importance sampling of the\n"
           "cube's level 0 (ibl::reference_ld, double): array (..., 3).");
+    m.def("extract_sun", &extract_sun, py::arg("cube"), py::kw_only(), py::arg("threshold_over_median") = 50.0,
+          py::arg("threshold_over_peak") = 1e-3, py::arg("max_solid_angle") = 1e-2, py::arg("min_share") = 0.2,
+          py::arg("threads") = 0u,
+          "Finds a sun (a compact, very bright region) in a cube and splits it off as a disk light\n"
+          "(ibl::extract_sun_in_place, env/sun_extract.hpp): (light, residual), or None when there is no\n"
+          "compact dominant source (no texel above the threshold, region above max_solid_angle, or less than\n"
+          "min_share of the irradiance facing it). light: dict with 'direction' (unit, towards the light),\n"
+          "'solid_angle' (sr) and 'angular_radius' (rad) of the equivalent uniform disk, its 'radiance' (RGB),\n"
+          "the 'irradiance' it delivers facing it (= radiance pi sin^2 angular_radius), 'region_solid_angle',\n"
+          "'region_texels' and 'share'. residual: float32 (6, n, n, 3), the region filled harmonically from\n"
+          "its ring.");
+    m.def("reference_radiance", &reference_radiance, py::arg("cube"), py::arg("n"), py::arg("v"), py::arg("base_color"),
+          py::arg("metallic"), py::arg("roughness"), py::kw_only(), py::arg("samples") = 4096, py::arg("batches") = 16,
+          py::arg("seed") = 0u, py::arg("strategy") = "mis", py::arg("diffuse") = "lambert", py::arg("dielectric_f0") = 0.04,
+          py::arg("threads") = 0u,
+          "Outgoing radiance Lo(n, v) of a metallic-roughness material under the cube WITHOUT the split sum\n"
+          "(ibl::reference_radiance, reference/radiance.hpp: GGX height-correlated specular + Lambert, single\n"
+          "scattering, F90 = 1), by multiple importance sampling of the BRDF and the environment (randomised\n"
+          "QMC in `batches` independent batches, `samples` radiance evaluations per point). n, v (..., 3)\n"
+          "(normalised here), base_color (..., 3), metallic, roughness broadcast; all in [0, 1] but n, v.\n"
+          "strategy 'mis', 'brdf' or 'env'; diffuse 'lambert' (k_d = 1) or 'one_minus_fresnel_roughness' (the\n"
+          "single-scattering shader's kD). Returns a dict of float64 arrays (..., 3): 'value', 'diffuse',\n"
+          "'specular' and 'std_error' (of value, from the batch means). Deterministic for given inputs.");
 }
 
 } // namespace ibl_py

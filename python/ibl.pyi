@@ -3,7 +3,7 @@
 # vector is expected), compute in float32 when every NumPy input is float32 and in float64
 # otherwise, and return a new array (a Python float when every input is a scalar). Roughness and
 # alpha arguments must lie in [0, 1] (ValueError otherwise, also for NaN).
-from typing import Protocol, Sequence, Union
+from typing import Any, Optional, Protocol, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -62,6 +62,10 @@ def dfg_lut(size: int, model: Model = "ggx_height_correlated", *, layout: str = 
             multiscatter: bool = False, threads: int = 0) -> np.ndarray: ...  # float32 (size, size, 2 or 3)
 def dfg_smooth_limit(n_dot_v: ArrayLike) -> np.ndarray: ...  # (..., 2)
 def dfg_lut_coords(size: int, layout: str = "uniform") -> tuple[np.ndarray, np.ndarray]: ...  # (n_dot_v, roughness)
+def dfg_mc(n_dot_v: ArrayLike, roughness: ArrayLike, samples: int = 1024, model: str = "ggx_height_correlated", *,
+           sampling: str = "ndf") -> np.ndarray: ...  # (..., 2); sampling "ndf" | "vndf"; built-in models only
+def dfg_albedo(n_dot_v: ArrayLike, roughness: ArrayLike, model: str = "ggx_height_correlated") -> Real: ...  # E = A + B
+def dfg_energy_compensation(albedo: ArrayLike) -> Real: ...  # (1 - E) / E
 
 # ---- cubes: (6, n, n, 3) float32, faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0 ----
 def prefilter(cube: ArrayLike, *, levels: int = -1, samples: int = 0, method: str = "fis",
@@ -73,3 +77,26 @@ def sh_evaluate(coeffs: ArrayLike, dirs: ArrayLike) -> np.ndarray: ...  # (..., 
 def sh_irradiance(coeffs: ArrayLike) -> np.ndarray: ...  # (bands^2, 3)
 def reference_ld(cube: ArrayLike, dirs: ArrayLike, roughness: ArrayLike, samples: int = 4096, *,
                  weight: str = "n_dot_l", threads: int = 0) -> np.ndarray: ...  # (..., 3)
+def extract_sun(cube: ArrayLike, *, threshold_over_median: float = 50.0, threshold_over_peak: float = 1e-3,
+                max_solid_angle: float = 1e-2, min_share: float = 0.2,
+                threads: int = 0) -> Optional[tuple[dict[str, Any], np.ndarray]]: ...  # (light, residual cube) or None
+def reference_radiance(cube: ArrayLike, n: ArrayLike, v: ArrayLike, base_color: ArrayLike, metallic: ArrayLike,
+                       roughness: ArrayLike, *, samples: int = 4096, batches: int = 16, seed: int = 0,
+                       strategy: str = "mis", diffuse: str = "lambert", dielectric_f0: float = 0.04,
+                       threads: int = 0) -> dict[str, np.ndarray]: ...  # value, diffuse, specular, std_error: (..., 3)
+
+# ---- files (the bake tool's I/O library; has_image_io False: RuntimeError) ----
+has_image_io: bool
+def read_image(path: str, *, latlong: bool = False, max_pixels: int = 134217728,
+               replace_nonfinite: bool = False) -> np.ndarray: ...  # float32 (h, w, 3), row 0 at the top
+def read_ktx2(path: str) -> list[np.ndarray]: ...  # float32 (6, s, s, 3) per level
+def cube_from_latlong(img: ArrayLike, size: int, supersample: int = 2, *, threads: int = 0) -> np.ndarray: ...  # (6, size, size, 3)
+
+# ---- runtime lookups (float inside; float32 out when every NumPy input is float32) ----
+def specular_lookup(chain_levels: Sequence[ArrayLike], dirs: ArrayLike, roughness: ArrayLike, *,
+                    lookup: str = "textbook", mapping: str = "linear") -> np.ndarray: ...  # (..., 3)
+def dfg_lookup(lut: ArrayLike, n_dot_v: ArrayLike, roughness: ArrayLike, *,
+               layout: str = "uniform") -> np.ndarray: ...  # (..., channels of lut)
+def shade_ambient(n_dot_v: ArrayLike, ld: ArrayLike, dfg: ArrayLike, irradiance_over_pi: ArrayLike,
+                  base_color: ArrayLike, metallic: ArrayLike, roughness: ArrayLike, *, ao: ArrayLike = 1.0,
+                  dielectric_f0: float = 0.04, multiscatter: bool = True) -> np.ndarray: ...  # (..., 3)
