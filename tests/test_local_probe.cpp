@@ -216,3 +216,75 @@ TEST_CASE("local probe: blend contributions and the fallback sum to one; priorit
         prev[0] = c[0], prev[1] = c[1], prev_f = f;
     }
 }
+
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/core/color.hpp>
+#include <ibl/env/convert.hpp>
+#include <ibl/reference/analytic_room.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/reference/metrics.hpp>
+#include <ibl/runtime/lookup.hpp>
+
+TEST_CASE("analytic room: traces land on the walls, a capture from a point sees the room from there") {
+    const ibl::analytic_room<double> room;
+    std::mt19937_64 rng(21);
+    for (int k = 0; k < 1000; ++k) {
+        const dvec3 p(-3.5 + 7.0 * std::uniform_real_distribution<double>(0, 1)(rng), 0.2 + 2.6 * std::uniform_real_distribution<double>(0, 1)(rng),
+                      -2.5 + 7.0 * std::uniform_real_distribution<double>(0, 1)(rng));
+        const dvec3 d = random_unit(rng);
+        int wall = -1;
+        const double t = room.exit(p, d, wall);
+        REQUIRE(wall >= 0);
+        const dvec3 x = p + t * d;
+        const int axis = wall / 2;
+        CHECK(x[axis] == doctest::Approx(wall % 2 ? room.hi[axis] : room.lo[axis]).epsilon(1e-12));
+        const dvec3 l = room.trace(p, d);
+        CHECK(l.x > 0.0);
+        CHECK(l.y > 0.0);
+    }
+    int wall = 0;
+    CHECK(room.exit(dvec3(10.0, 1.0, 0.0), dvec3(1.0, 0.0, 0.0), wall) == -1.0); // outside
+    CHECK(room.trace(dvec3(10.0, 1.0, 0.0), dvec3(1.0, 0.0, 0.0)) == dvec3(0.0));
+    // the emitter is brightest straight above its centre
+    CHECK(ibl::luminance(room.trace(dvec3(room.emitter_x, 1.0, room.emitter_z), dvec3(0, 1, 0))) > 30.0);
+}
+
+TEST_CASE("local probes in the analytic room: parallax correction and distance-based roughness cut the error") {
+    // Small and fast (64^2 captures, 12 points x 8 directions, 1024-sample references); the full
+    // study with its figures is research/local_probe_error (docs/local_probes.md).
+    const ibl::analytic_room<double> room;
+    const dvec3 c = 0.5 * (room.lo + room.hi);
+    ibl::cubemap<float> cube = ibl::bake_cubemap<float>(ibl::room_view<double>{&room, c}, 64, 2, ibl::serial_executor{});
+    cube.generate_mips();
+    const ibl::specular_chain chain = ibl::prefilter(cube, ibl::prefilter_options{}, ibl::thread_executor{2});
+    const auto proxy = ibl::probe_box<double>::axis_aligned(room.lo, room.hi);
+    std::vector<dvec3> points, dirs;
+    for (int i = 0; i < 12; ++i)
+        points.push_back(dvec3(-3.0 + 2.0 * (i % 4), 0.8 + 0.7 * (i % 3), -2.0 + 2.5 * (i % 3) + 0.5 * (i / 4)));
+    for (int k = 0; k < 8; ++k) {
+        const double z = 1.0 - (2.0 * k + 1.0) / 8.0, ph = 2.399963229728653 * k, s = std::sqrt(1.0 - z * z);
+        dirs.push_back(dvec3(s * std::cos(ph), z, s * std::sin(ph)));
+    }
+    for (double r : {0.0, 0.4}) {
+        CAPTURE(r);
+        double mean = 0.0;
+        std::vector<double> truth, none, fixed;
+        for (const dvec3& p : points)
+            for (const dvec3& R : dirs) {
+                const ibl::room_view<double> view{&room, p};
+                truth.push_back(ibl::luminance(r == 0.0 ? room.trace(p, R) : ibl::reference_ld(view, R, r, 1024)));
+                none.push_back(ibl::luminance(dvec3(ibl::specular_lookup(chain, ibl::vec3<float>(R), float(r)))));
+                const ibl::parallax_lookup<double> l = ibl::parallax_correct(proxy, c, p, R);
+                const double rc = ibl::corrected_roughness(r, l.d_shading, l.d_probe);
+                fixed.push_back(ibl::luminance(dvec3(ibl::specular_lookup(chain, ibl::vec3<float>(l.direction), float(rc)))));
+                mean += truth.back();
+            }
+        mean /= double(truth.size());
+        ibl::error_accumulator a(1e-3 * mean), b(1e-3 * mean);
+        for (std::size_t i = 0; i < truth.size(); ++i) a.add(none[i], truth[i]), b.add(fixed[i], truth[i]);
+        const double e_none = a.finish().rel_rmse, e_fixed = b.finish().rel_rmse;
+        MESSAGE("r = " << r << ": uncorrected " << e_none << ", corrected " << e_fixed);
+        CHECK(e_fixed < 0.5 * e_none);
+        if (r == 0.0) CHECK(e_fixed < 0.06); // mirror at 64^2 faces (0.5% at 256^2: docs/local_probes.md)
+    }
+}
