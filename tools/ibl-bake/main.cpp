@@ -1,7 +1,7 @@
 // tools/ibl-bake/main.cpp — ibl-bake: bakes image-based-lighting products from a lat-long HDR
 // image (Radiance .hdr, OpenEXR) or the built-in sky + sun, with a preview and an error/time
 // report; `--scene` bakes only what a scene needs. Usage and file formats: docs/ibl-bake.md,
-// `ibl-bake --help`.
+// `ibl-bake --help`. `--probes` bakes a set of local reflection probes (stages/probe_bake.hpp).
 //
 // Exit status: 0 success; 1 a failure while baking (unreadable / truncated / LDR input, a bad
 // scene file, a write error: the output directory is left as it was, see output_stage.hpp);
@@ -17,6 +17,8 @@
 #include "options/bake_options.hpp"
 #include "stages/pipeline.hpp"
 #include "query/lookup.hpp"
+#include "query/probe_lookup.hpp"
+#include "stages/probe_bake.hpp"
 #include "stages/stages.hpp"
 
 int main(int argc, char** argv) {
@@ -37,7 +39,13 @@ int main(int argc, char** argv) {
         return 0;
     }
     try {
+        if (!opt.lookup.empty() && is_probe_set_folder(opt.lookup))
+            return run_probe_lookup(load_probe_set(opt.lookup), std::cin, std::cout);
         if (!opt.lookup.empty()) return run_lookup(load_baked_folder(opt.lookup), std::cin, std::cout);
+        if (!opt.probes.empty()) {
+            run_probe_bake(opt, stdout);
+            return 0;
+        }
         run_bake(opt, stdout);
     } catch (const std::exception& e) {
         std::fprintf(stderr, "ibl-bake: error: %s\n", e.what());

@@ -424,7 +424,7 @@ ktx2_placement place_ktx2(ktx2_format format, std::size_t kvd_length, const std:
 
 /// The identifier, the header and the level index.
 void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, ktx2_format format, const ktx2_placement& p,
-                     bool supercompressed) {
+                     bool supercompressed, std::uint32_t layer_count = 0) {
     const std::size_t L = p.offset.size();
     std::memcpy(b.data(), ktx2_identifier, sizeof ktx2_identifier);
     put32(b, 12, std::uint32_t(format));
@@ -432,7 +432,7 @@ void put_ktx2_header(std::vector<unsigned char>& b, const cubemap_rgb32f& cube, 
     put32(b, 20, std::uint32_t(cube.size));
     put32(b, 24, std::uint32_t(cube.size));
     put32(b, 28, 0); // pixelDepth
-    put32(b, 32, 0); // layerCount
+    put32(b, 32, layer_count); // layerCount (0: not an array)
     put32(b, 36, 6); // faceCount
     put32(b, 40, std::uint32_t(L));
     put32(b, 44, supercompressed ? ktx2_ss_zstd : 0);
@@ -486,11 +486,19 @@ std::vector<unsigned char> zstd_deflate(const std::vector<unsigned char>& raw, i
 
 } // namespace
 
-std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
-                                               const std::string& name, ktx2_clamp_counts* counts,
-                                               const std::vector<std::pair<std::string, std::string>>& metadata,
-                                               const ktx2_encoding& encoding) {
-    check_cube(cube, name);
+namespace {
+/// The file of `layers` cubemaps (checked: equal sizes and level counts); layer_count 0 writes a
+/// single cubemap (layers has one element), n >= 1 an array of n.
+std::vector<unsigned char> encode_layers(const std::vector<const cubemap_rgb32f*>& layers, std::uint32_t layer_count,
+                                         ktx2_format format, const std::string& writer, const std::string& name,
+                                         ktx2_clamp_counts* counts, const std::vector<std::pair<std::string, std::string>>& metadata,
+                                         const ktx2_encoding& encoding) {
+    if (layers.empty()) throw image_error(name, "a cubemap array needs at least one layer");
+    for (const cubemap_rgb32f* c : layers) {
+        check_cube(*c, name);
+        if (c->size != layers[0]->size || c->levels.size() != layers[0]->levels.size())
+            throw image_error(name, "the layers of a cubemap array differ in face size or level count");
+    }
     if (!known_format(std::uint32_t(format)))
         throw image_error(name, "unsupported KTX2 format " + std::to_string(std::uint32_t(format)));
     if (encoding.zstd_level < 0 || encoding.zstd_level > ZSTD_maxCLevel())
@@ -499,22 +507,47 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
     const std::vector<std::pair<std::string, std::string>> kv = ktx2_key_values(writer, name, metadata, kvd_length);
     const bool zstd = encoding.zstd_level > 0;
     ktx2_clamp_counts seen;
+    const cubemap_rgb32f& cube = *layers[0];
     std::vector<std::vector<unsigned char>> levels(cube.levels.size());
     std::vector<std::size_t> raw(cube.levels.size());
     for (std::size_t l = 0; l < levels.size(); ++l) {
-        levels[l] = level_texels(cube, l, format, encoding, seen);
+        // KTX2 order within a level: for each layer, for each face
+        for (const cubemap_rgb32f* c : layers) {
+            const std::vector<unsigned char> one = level_texels(*c, l, format, encoding, seen);
+            levels[l].insert(levels[l].end(), one.begin(), one.end());
+        }
         raw[l] = levels[l].size();
         if (zstd) levels[l] = zstd_deflate(levels[l], encoding.zstd_level, name);
     }
     const ktx2_placement p = place_ktx2(format, kvd_length, levels, raw, zstd);
     std::vector<unsigned char> b(p.size, 0);
-    put_ktx2_header(b, cube, format, p, zstd);
+    put_ktx2_header(b, cube, format, p, zstd, layer_count);
     put_dfd(b, p.dfd_offset, format, p.dfd_total, texel_bytes(format));
     put_key_values(b, p.kvd_offset, kv);
     for (std::size_t l = 0; l < levels.size(); ++l)
         if (!levels[l].empty()) std::memcpy(b.data() + p.offset[l], levels[l].data(), levels[l].size());
     if (counts) *counts = seen;
     return b;
+}
+} // namespace
+
+std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
+                                               const std::string& name, ktx2_clamp_counts* counts,
+                                               const std::vector<std::pair<std::string, std::string>>& metadata,
+                                               const ktx2_encoding& encoding) {
+    return encode_layers({&cube}, 0, format, writer, name, counts, metadata, encoding);
+}
+
+std::vector<unsigned char> encode_ktx2_cubemap_array(const std::vector<cubemap_rgb32f>& layers, ktx2_format format,
+                                                     const std::string& writer, const std::string& name, ktx2_clamp_counts* counts,
+                                                     const std::vector<std::pair<std::string, std::string>>& metadata,
+                                                     const ktx2_encoding& encoding) {
+    if (layers.empty() || layers.size() > ktx2_max_array_layers)
+        throw image_error(name, "a cubemap array takes 1.." + std::to_string(ktx2_max_array_layers) + " layers, got " +
+                                    std::to_string(layers.size()));
+    std::vector<const cubemap_rgb32f*> p;
+    for (const cubemap_rgb32f& c : layers) p.push_back(&c);
+    return encode_layers(p, std::uint32_t(layers.size()), format, writer, name, counts, metadata, encoding);
 }
 
 void write_ktx2_cubemap(const std::string& path, const cubemap_rgb32f& cube, ktx2_format format, const std::string& writer,
@@ -579,7 +612,34 @@ ktx2_info parse_ktx2(std::span<const unsigned char> b, const std::string& name) 
     return k;
 }
 
-cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::string& name) {
+namespace {
+/// Unpacks one cubemap level of a texel format (6 faces of s x s) into faces.
+void decode_texels(ktx2_format fmt, std::span<const unsigned char> level, std::size_t s, std::array<std::vector<float>, 6>& faces) {
+    const std::size_t tb = texel_bytes(fmt);
+    std::size_t at = 0;
+    for (std::size_t f = 0; f < 6; ++f)
+        for (std::size_t t = 0; t < s * s; ++t, at += tb) {
+            float* out = faces[f].data() + 3 * t;
+            switch (fmt) {
+            case ktx2_format::rgba32f:
+                for (std::size_t ch = 0; ch < 3; ++ch) out[ch] = std::bit_cast<float>(get32(level, at + 4 * ch));
+                break;
+            case ktx2_format::rgba16f:
+                for (std::size_t ch = 0; ch < 3; ++ch)
+                    out[ch] = half_to_float(static_cast<std::uint16_t>(level[at + 2 * ch] | (level[at + 2 * ch + 1] << 8)));
+                break;
+            case ktx2_format::b10g11r11: unpack_b10g11r11(get32(level, at), out); break;
+            case ktx2_format::e5b9g9r9: unpack_e5b9g9r9(get32(level, at), out); break;
+            default: break;
+            }
+        }
+}
+} // namespace
+
+namespace {
+/// The layers of a cubemap (array = false: a single cubemap, layerCount 0) or a cubemap array
+/// (array = true: layerCount 1..ktx2_max_array_layers).
+std::vector<cubemap_rgb32f> decode_layers(std::span<const unsigned char> b, const std::string& name, bool array) {
     const ktx2_info k = parse_ktx2(b, name);
     const auto bad = [&](const std::string& what) { return image_error(name, "unsupported KTX2 cubemap: " + what); };
     if (!known_format(k.vk_format))
@@ -592,7 +652,11 @@ cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::
     const bool zstd = k.supercompression == ktx2_ss_zstd;
     if (k.supercompression != 0 && !zstd)
         throw bad("supercompression scheme " + std::to_string(k.supercompression) + " (readable: 0 none, 2 Zstandard)");
-    if (k.face_count != 6 || k.layer_count != 0 || k.pixel_depth != 0) throw bad("not a single cubemap");
+    if (!array && (k.face_count != 6 || k.layer_count != 0 || k.pixel_depth != 0)) throw bad("not a single cubemap");
+    if (array && (k.face_count != 6 || k.pixel_depth != 0)) throw bad("not a cubemap array (faceCount " + std::to_string(k.face_count) + ")");
+    if (array && (k.layer_count < 1 || k.layer_count > ktx2_max_array_layers))
+        throw bad("layerCount " + std::to_string(k.layer_count) + " (a cubemap array has 1.." + std::to_string(ktx2_max_array_layers) + ")");
+    const std::size_t layers = array ? k.layer_count : 1;
     if (k.pixel_width != k.pixel_height || k.pixel_width < 1 || k.pixel_width > 65536) throw bad("faces not square");
     const std::uint32_t want_type_size = type_size(fmt);
     if (k.type_size != want_type_size)
@@ -606,14 +670,15 @@ cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::
     std::uint64_t total = 0;
     for (std::size_t l = 0; l < k.levels.size(); ++l) {
         const std::size_t s = std::max<std::size_t>(1, std::size_t(k.pixel_width) >> l);
-        total += level_bytes(fmt, s) + 6 * s * s * 12; // the stored level and its floats
+        total += (level_bytes(fmt, s) + 6 * s * s * 12) * layers; // the stored level and its floats
+        if (total > max_inflated_bytes) break;
     }
     if (total > max_inflated_bytes) throw bad("the decoded cubemap would take more than 2 GiB");
-    cubemap_rgb32f c = cubemap_rgb32f::zeros(int(k.pixel_width), int(k.levels.size()));
+    std::vector<cubemap_rgb32f> out(layers, cubemap_rgb32f::zeros(int(k.pixel_width), int(k.levels.size())));
     std::vector<unsigned char> inflated;
     for (std::size_t l = 0; l < k.levels.size(); ++l) {
-        const std::size_t s = std::size_t(c.face_size(int(l)));
-        const std::size_t want = level_bytes(fmt, s);
+        const std::size_t s = std::size_t(out[0].face_size(int(l)));
+        const std::size_t one = level_bytes(fmt, s), want = one * layers;
         std::span<const unsigned char> level;
         if (zstd) {
             if (k.levels[l].uncompressed_byte_length != want)
@@ -634,31 +699,29 @@ cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::
                 throw bad("level " + std::to_string(l) + " has the wrong size or alignment");
             level = b.subspan(std::size_t(k.levels[l].byte_offset), want);
         }
-        if (ktx2_block_compressed(fmt)) {
-            const std::size_t fb = block_image_bytes(fmt, int(s));
-            for (std::size_t f = 0; f < 6; ++f) c.levels[l][f] = decode_block_image(fmt, level.data() + f * fb, fb, int(s));
-            continue;
-        }
-        std::size_t at = 0;
-        for (std::size_t f = 0; f < 6; ++f)
-            for (std::size_t t = 0; t < s * s; ++t, at += tb) {
-                float* out = c.levels[l][f].data() + 3 * t;
-                switch (fmt) {
-                case ktx2_format::rgba32f:
-                    for (std::size_t ch = 0; ch < 3; ++ch) out[ch] = std::bit_cast<float>(get32(level, at + 4 * ch));
-                    break;
-                case ktx2_format::rgba16f:
-                    for (std::size_t ch = 0; ch < 3; ++ch)
-                        out[ch] = half_to_float(static_cast<std::uint16_t>(level[at + 2 * ch] | (level[at + 2 * ch + 1] << 8)));
-                    break;
-                case ktx2_format::b10g11r11: unpack_b10g11r11(get32(level, at), out); break;
-                case ktx2_format::e5b9g9r9: unpack_e5b9g9r9(get32(level, at), out); break;
-                default: break;
-                }
+        for (std::size_t layer = 0; layer < layers; ++layer) {
+            cubemap_rgb32f& c = out[layer];
+            const std::span<const unsigned char> part = level.subspan(layer * one, one);
+            if (ktx2_block_compressed(fmt)) {
+                const std::size_t fb = block_image_bytes(fmt, int(s));
+                for (std::size_t f = 0; f < 6; ++f) c.levels[l][f] = decode_block_image(fmt, part.data() + f * fb, fb, int(s));
+                continue;
             }
+            decode_texels(fmt, part, s, c.levels[l]);
+        }
     }
-    return c;
+    return out;
 }
+} // namespace
+
+cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> b, const std::string& name) {
+    return std::move(decode_layers(b, name, false).front());
+}
+
+std::vector<cubemap_rgb32f> decode_ktx2_cubemap_array(std::span<const unsigned char> b, const std::string& name) {
+    return decode_layers(b, name, true);
+}
+
 
 // ---- quantisation report -----------------------------------------------------------------------
 

@@ -1,5 +1,5 @@
 #pragma once
-// tools/ibl-bake/io/ktx2.hpp — KTX 2.0 cubemap writer (and a validating reader for tests and
+// tools/ibl-bake/io/ktx2.hpp — KTX 2.0 cubemap (and cubemap-array) writer (and a validating reader for tests and
 // verification) for a mip chain of 6 faces of linear RGB float data.
 //
 // Why KTX2: a published, complete specification (Khronos KTX File Format 2.0), cubemap face order
@@ -12,7 +12,8 @@
 //          16   typeSize    4 (RGBA32F), 2 (RGBA16F), 4 (the two PACK32 formats: the size of the packed word),
 //                           1 (the block formats)
 //          20   pixelWidth  n (face size of level 0), 24 pixelHeight n, 28 pixelDepth 0
-//          32   layerCount  0 (not an array), 36 faceCount 6, 40 levelCount L (>= 1),
+//          32   layerCount  0 (not an array; N for encode_ktx2_cubemap_array's N layers),
+//               36 faceCount 6, 40 levelCount L (>= 1),
 //          44   supercompressionScheme 0 (none) or 2 (Zstandard, ktx2_encoding::zstd_level > 0)
 //          48   index: dfdByteOffset, dfdByteLength, kvdByteOffset, kvdByteLength (u32),
 //               sgdByteOffset = 0, sgdByteLength = 0 (u64)
@@ -146,6 +147,20 @@ std::vector<unsigned char> encode_ktx2_cubemap(const cubemap_rgb32f& cube, ktx2_
                                                ktx2_clamp_counts* counts = nullptr,
                                                const std::vector<std::pair<std::string, std::string>>& metadata = {},
                                                const ktx2_encoding& encoding = {});
+/// Most layers of a cubemap array (encode_ktx2_cubemap_array, decode_ktx2_cubemap_array).
+inline constexpr std::uint32_t ktx2_max_array_layers = 2048;
+
+/// A cubemap ARRAY of layers.size() cubemaps (1..ktx2_max_array_layers, equal face sizes and level
+/// counts): the layout of the header comment with layerCount = the number of layers and each
+/// level holding, as the KTX2 specification orders it, for each layer its 6 faces (layer-major,
+/// then face). Everything else (formats, DFD, key/values, alignment, Zstandard per level) as
+/// encode_ktx2_cubemap. Throws image_error named `name`.
+std::vector<unsigned char> encode_ktx2_cubemap_array(const std::vector<cubemap_rgb32f>& layers, ktx2_format format,
+                                                     const std::string& writer = "ibl-bake",
+                                                     const std::string& name = "<ktx2>",
+                                                     ktx2_clamp_counts* counts = nullptr,
+                                                     const std::vector<std::pair<std::string, std::string>>& metadata = {},
+                                                     const ktx2_encoding& encoding = {});
 /// encode_ktx2_cubemap + write_file_atomic.
 /// metadata: extra key/value pairs (UTF-8 keys without NUL, not starting with "KTX"; written sorted
 /// by key after KTXwriter's place in that order).
@@ -176,6 +191,11 @@ ktx2_info parse_ktx2(std::span<const unsigned char> bytes, const std::string& na
 /// block formats decoded as a GPU decodes them; Zstandard levels inflated, at most 2 GiB in all).
 /// Besides the header it checks typeSize and the DFD's bytesPlane0 against the format.
 cubemap_rgb32f decode_ktx2_cubemap(std::span<const unsigned char> bytes, const std::string& name = "<ktx2>");
+
+/// Reads back a cubemap array written by encode_ktx2_cubemap_array: the checks of
+/// decode_ktx2_cubemap, except that layerCount must be in 1..ktx2_max_array_layers (a single
+/// cubemap, layerCount 0, is refused here as an array is by decode_ktx2_cubemap).
+std::vector<cubemap_rgb32f> decode_ktx2_cubemap_array(std::span<const unsigned char> bytes, const std::string& name = "<ktx2>");
 
 /// IEEE binary16 conversions used by the RGBA16F path (see the header comment for the policy).
 std::uint16_t float_to_half(float f) noexcept;

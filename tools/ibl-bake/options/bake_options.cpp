@@ -215,6 +215,7 @@ option_map convention_options() {
 option_map file_options() {
     return {
         {"--scene", {true, [](bake_options& o, const std::string& v) { o.scene = path_value("--scene", v); }}},
+        {"--probes", {true, [](bake_options& o, const std::string& v) { o.probes = path_value("--probes", v); }}},
         {"--input", {true, [](bake_options& o, const std::string& v) { o.input = path_value("--input", v); }}},
         {"--out", {true, [](bake_options& o, const std::string& v) { o.out = path_value("--out", v); }}},
         {"--lookup", {true, [](bake_options& o, const std::string& v) { o.lookup = path_value("--lookup", v); }}},
@@ -273,11 +274,13 @@ const option_map& option_table() {
 /// Checks that need every option: required ones, combinations, --levels against --size.
 void check_combination(const bake_options& o, bool have_out) {
     if (!o.lookup.empty()) {
-        if (have_out || !o.input.empty() || !o.scene.empty())
-            throw usage_error("--lookup DIR answers queries about an existing bake: no --out, --input or --scene");
+        if (have_out || !o.input.empty() || !o.scene.empty() || !o.probes.empty())
+            throw usage_error("--lookup DIR answers queries about an existing bake: no --out, --input, --scene or --probes");
         return;
     }
     if (!have_out) throw usage_error("--out DIR is required");
+    if (!o.probes.empty() && (!o.input.empty() || !o.scene.empty()))
+        throw usage_error("--probes takes each probe's input from its file: no --input or --scene");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.strict && o.scene.empty()) throw usage_error("--strict needs --scene");
     if (o.levels > 0) {
@@ -321,6 +324,7 @@ bake_options parse_options(const std::vector<std::string>& args) {
 
 std::string usage_text() {
     return "usage: ibl-bake --out DIR [options]\n"
+           "       ibl-bake --probes probes.json --out DIR [options]\n"
            "       ibl-bake --lookup DIR < queries   (answers as the shader does; docs/ibl-bake.md)\n"
            "Bakes image-based-lighting products (prefiltered specular cubemap, SH irradiance, DFG LUT),\n"
            "a preview and an error/time report from a lat-long HDR image or the built-in sky.\n\n"
@@ -361,8 +365,11 @@ std::string usage_text() {
            "  --runtime M        split-sum (default: LD(R, r) DFG) | lobe (lobe LUT) | taps2 (two fitted taps)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"
            "                     irradiance X Y Z, shade NX NY NZ VX VY VZ R M BR BG BB, sheen X Y Z R,\n"
-           "                     dfg_sheen NV R (--sheen bakes), lobe NV R, taps NV R\n"
+           "                     dfg_sheen NV R (--sheen bakes), lobe NV R, taps NV R; on a probe set:\n"
+           "                     local PX PY PZ DX DY DZ R, local_irradiance PX PY PZ NX NY NZ\n"
            "  --scene PATH       bake only what the scene needs (docs/scene-format.md)\n"
+           "  --probes PATH      bake the local reflection probes of PATH (JSON) into DIR: probes.ktx2 (a\n"
+           "                     cubemap array of the chains), probes.json (volumes, SH3, conventions)\n"
            "  --compare-full     with --scene: also time the full bake and measure the error\n"
            "  --strict           with --scene: a missed error target is an error (exit 1, DIR untouched)\n"
            "  --help, --version\n";

@@ -45,6 +45,7 @@
 //                       (the fitted two-tap model, lobe_taps_a.exr, lobe_taps_b.exr)
 //   --lookup DIR        answer queries on stdin about the bake in DIR (lookup.hpp); no --out
 //   --scene PATH        bake only what the scene needs (docs/scene-format.md)
+//   --probes PATH       bake the local reflection probes of PATH into DIR (probes.ktx2, probes.json)
 //   --compare-full      with --scene: also bake and time the full products, measure the error
 //   --strict            with --scene: a missed error target is an error (exit 1, DIR untouched)
 //   --checks C          fast (default: cheaper references, checks <= 1/4 of the run) | full | none
@@ -161,6 +162,7 @@ struct bake_options {
     prefilter_choice prefilter = prefilter_choice::fis; ///< --prefilter: the chain's filter
     runtime_choice runtime = runtime_choice::split_sum;
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
+    std::string probes;        ///< --probes: bake this probe set (io/probes_reader.hpp, stages/probe_bake.hpp)
     std::string scene;         ///< --scene: plan from this scene file (scene_reader.hpp, stage_plan.cpp)
     bool compare_full = false; ///< --compare-full (with --scene)
     bool strict = false;       ///< --strict (with --scene): a missed error target fails the bake

@@ -35,6 +35,7 @@
 // a non-number, a zero or non-finite direction) gets one line "error: line L: <why>: <the query>"
 // in place of its answer; the exit status is then 1 (0 when every query was answered).
 // Numbers are printed with 9 significant digits (they read back as the same float).
+// A probe-set folder (the output of --probes) is answered by query/probe_lookup.hpp instead.
 
 #include <iosfwd>
 #include <string>
