@@ -21,6 +21,11 @@
 
 namespace ibl_bake {
 
+using query_text::fmt9;
+using query_text::numbers;
+using query_text::triple;
+using query_text::unit;
+
 namespace {
 
 using ibl_examples::json_value;
@@ -72,32 +77,6 @@ diffuse_data sh_from_json(const std::string& path) {
             d.radiance[int(i)][c] = r.values[i].values.at(std::size_t(c)).number;
         }
     return d;
-}
-
-/// The numbers after the query word; false if one is not a finite number.
-bool numbers(std::istringstream& in, std::vector<double>& out) {
-    std::string w;
-    while (in >> w) {
-        double x = 0.0;
-        const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
-        if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x)) return false;
-        out.push_back(x);
-    }
-    return true;
-}
-
-std::string fmt9(double x) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.9g", x);
-    return b;
-}
-std::string triple(const dvec3& v) { return fmt9(v.x) + " " + fmt9(v.y) + " " + fmt9(v.z); }
-
-dvec3 unit(double x, double y, double z, const char* what) {
-    const dvec3 d(x, y, z);
-    const double l = std::sqrt(glm::dot(d, d));
-    if (!(l > 0.0) || !std::isfinite(l)) throw std::invalid_argument(std::string(what) + " is zero or not finite");
-    return d / l;
 }
 
 double unit_interval(double x) { return std::clamp(x, 0.0, 1.0); }
@@ -192,6 +171,36 @@ std::string answer(const baked_folder& b, const product_view& v, const std::stri
 }
 
 } // namespace
+
+namespace query_text {
+
+bool numbers(std::istringstream& in, std::vector<double>& out) {
+    std::string w;
+    while (in >> w) {
+        double x = 0.0;
+        const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
+        if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x)) return false;
+        out.push_back(x);
+    }
+    return true;
+}
+
+std::string fmt9(double x) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.9g", x);
+    return b;
+}
+std::string triple(const dvec3& v) { return fmt9(v.x) + " " + fmt9(v.y) + " " + fmt9(v.z); }
+
+dvec3 unit(double x, double y, double z, const char* what) {
+    const dvec3 d(x, y, z);
+    const double l = std::sqrt(glm::dot(d, d));
+    if (!(l > 0.0) || !std::isfinite(l)) throw std::invalid_argument(std::string(what) + " is zero or not finite");
+    return d / l;
+}
+
+} // namespace query_text
+
 
 product_view baked_folder::view() const {
     product_view v;

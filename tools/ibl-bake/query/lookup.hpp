@@ -38,7 +38,9 @@
 // A probe-set folder (the output of --probes) is answered by query/probe_lookup.hpp instead.
 
 #include <iosfwd>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include "stages/stages.hpp"
 
@@ -75,5 +77,16 @@ baked_folder load_baked_folder(const std::string& dir);
 
 /// Answers the queries of `in` on `out` (see the header). Returns the exit status (0 or 1).
 int run_lookup(const baked_folder& b, std::istream& in, std::ostream& out);
+
+/// What both query modes (a bake folder, a probe set) share, so that they read and answer alike.
+namespace query_text {
+/// The numbers after the query word; false if one is not a finite number.
+bool numbers(std::istringstream& in, std::vector<double>& out);
+/// A number as every answer prints it (9 significant digits) and an RGB / XYZ triple of them.
+std::string fmt9(double x);
+std::string triple(const ibl::vec3<double>& v);
+/// (x, y, z) normalised; std::invalid_argument naming `what` when zero or not finite.
+ibl::vec3<double> unit(double x, double y, double z, const char* what);
+} // namespace query_text
 
 } // namespace ibl_bake

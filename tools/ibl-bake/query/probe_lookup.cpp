@@ -1,6 +1,7 @@
 // tools/ibl-bake/query/probe_lookup.cpp — see probe_lookup.hpp.
 
 #include "query/probe_lookup.hpp"
+#include "query/lookup.hpp"
 
 #include <algorithm>
 #include <charconv>
@@ -56,32 +57,12 @@ struct probe_json {
     }
 };
 
-bool numbers(std::istringstream& in, std::vector<double>& out) {
-    std::string w;
-    while (in >> w) {
-        double x = 0.0;
-        const auto r = std::from_chars(w.data(), w.data() + w.size(), x);
-        if (r.ec != std::errc() || r.ptr != w.data() + w.size() || !std::isfinite(x)) return false;
-        out.push_back(x);
-    }
-    return true;
-}
-
-std::string fmt9(double x) {
-    char b[32];
-    std::snprintf(b, sizeof b, "%.9g", x);
-    return b;
-}
-std::string triple(const dv3& v) { return fmt9(v.x) + " " + fmt9(v.y) + " " + fmt9(v.z); }
-
-dv3 unit(double x, double y, double z, const char* what) {
-    const dv3 d(x, y, z);
-    const double l = std::sqrt(glm::dot(d, d));
-    if (!(l > 0.0) || !std::isfinite(l)) throw std::invalid_argument(std::string(what) + " is zero or not finite");
-    return d / l;
-}
-
 } // namespace
+
+using query_text::fmt9;
+using query_text::numbers;
+using query_text::triple;
+using query_text::unit;
 
 bool is_probe_set_folder(const std::string& dir) {
     std::error_code ec;
