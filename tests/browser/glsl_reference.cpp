@@ -878,12 +878,13 @@ void print_fixtures() {
 /// sky baked to 32^2 and packed as the C++ kernel reads it (detail::pack_cube, 256 texels per
 /// row), and per convolved level of the fast filter's chain (ibl::prefilter, method fast, default
 /// plan) its single-level taps as the kernel runs them (make_ld_table_for + detail::make_taps, what
-/// prefilter builds) and the chain's texels (face, row, column) the GLSL must reproduce.
+/// prefilter builds; the peak split off) and the chain's texels (face, row, column) the GLSL must reproduce.
 void print_prefilter_fixtures() {
     constexpr int size = 32, width = 256;
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
     ibl::prefilter_options o;
     o.method = ibl::prefilter_method::fast;
+    o.peaks.enabled = false; // the GLSL filter runs the tap set only (docs/shaders.md)
     const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
     const ibl::detail::packed_cube packed = ibl::detail::pack_cube(src);
     const std::size_t texels = packed.data.size() / 4, height = (texels + width - 1) / width;

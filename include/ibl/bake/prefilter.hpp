@@ -106,6 +106,7 @@
 #include "../runtime/ld_weight.hpp"
 #include "../runtime/roughness_mip.hpp"
 #include "prefilter_fast.hpp"
+#include "prefilter_peaks.hpp"
 #include "sphere_convolve.hpp"
 
 namespace ibl {
@@ -157,6 +158,9 @@ struct prefilter_options {
     /// above, prefilter_plan(opt, base). When set, levels, samples, samples_per_level and
     /// trilinear are not read.
     std::vector<prefilter_level> level_plan{};
+    /// The fast filter's peak split (bake/prefilter_peaks.hpp): read by method = fast on a cubemap
+    /// source with the GGX lobe only.
+    peak_split_options peaks{};
 };
 
 /// Ceiling of the doubling sample schedule (samples per texel).
@@ -379,6 +383,67 @@ inline void check_prefilter_work(const prefilter_options& opt, const std::vector
 }
 } // namespace detail
 
+namespace detail {
+/// A convolved level of a cubemap source: its taps and its peaks.
+struct prefilter_cube_level {
+    tap_table taps{};
+    peak_level peaks{};
+};
+/// What prefilter reads from a cubemap source: the packed copy of the source (or of the base of
+/// its peak split), the split's peaks, and per level the taps and the merged peaks. The same
+/// object serves prefilter and prefilter_update, so both compute a row by the same operations.
+template <class Lobe, class T> class prefilter_cube_source {
+public:
+    template <class Executor>
+    prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, Executor& ex) : opt_(opt), n0_(src.size(0)) {
+        if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
+            if (opt.method == prefilter_method::fast && opt.peaks.enabled) {
+                cube_peak_split<T> split = split_cube_peaks(src, opt.peaks, ex);
+                peaks_ = std::move(split.peaks);
+                mean_ = split.mean_luminance;
+                if (!peaks_.empty()) {
+                    packed_ = pack_cube(split.base);
+                    table_source_levels_ = split.base.levels();
+                    return;
+                }
+            }
+        }
+        packed_ = pack_cube(src);
+        table_source_levels_ = src.levels();
+        (void)ex;
+    }
+    /// The taps of a plan level (tables from the source's lod mapping) and its peaks.
+    template <class Env> prefilter_cube_level level(const Env& env, const prefilter_level& lp) const {
+        prefilter_cube_level lv;
+        sphere_sample_table<float> table =
+            make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight);
+        table.trilinear = lp.trilinear;
+        lv.taps = make_taps(table, int(packed_.levels.size()));
+        lv.peaks = level_peaks(lp);
+        return lv;
+    }
+    /// The merged peaks of a plan level (empty without a split).
+    [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
+        if (peaks_.empty()) return {};
+        return make_peak_level(peaks_, n0_, table_source_levels_, lp.roughness, opt_.weight, opt_.peaks.footprint,
+                               opt_.peaks.max_merge_angle, mean_);
+    }
+    /// Row `row` (face n + y) of an n x n level.
+    void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out) const {
+        convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
+        splat_peaks_row(lv.peaks, int(row) / n, int(row) % n, n, out);
+    }
+    [[nodiscard]] std::size_t peak_count() const noexcept { return peaks_.size(); }
+
+private:
+    prefilter_options opt_;
+    int n0_ = 1, table_source_levels_ = 1;
+    double mean_ = 0.0;
+    packed_cube packed_{};
+    std::vector<cube_peak> peaks_;
+};
+} // namespace detail
+
 /// The prefiltered mip chain of an environment for lobe L (a specular_chain: the levels and the
 /// weight and mapping they were filtered with, runtime/chain.hpp) (sampling/lobe.hpp; GGX by default,
 /// prefilter<ibl::charlie_lobe>(env, opt) for sheen): output level k holds LD of the plan's level
@@ -398,6 +463,27 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
     detail::check_prefilter_work(opt, plan, base);
     cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()));
+    if constexpr (requires { detail::pack_cube(env); }) {
+        // Cubemap sources: one packed copy for every level, the peak split of the fast filter.
+        const detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, ex);
+        for (int k = 0; k < int(plan.size()); ++k) {
+            const prefilter_level& lp = plan[std::size_t(k)];
+            const int n = out.size(k);
+            std::vector<vec3<float>> texels;
+            if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
+                texels = detail::prefilter_base(env, n, lp.trilinear, ex);
+            } else {
+                const detail::prefilter_cube_level lv = cs.level(env, lp);
+                texels.resize(std::size_t(6) * std::size_t(n) * std::size_t(n));
+                ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, texels.data() + row * std::size_t(n));
+                });
+            }
+            out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
+        }
+        out.update_borders();
+        return specular_chain(std::move(out), opt.weight, opt.policy.mapping);
+    }
     for (int k = 0; k < int(plan.size()); ++k) {
         const prefilter_level& lp = plan[std::size_t(k)];
         const int n = out.size(k);

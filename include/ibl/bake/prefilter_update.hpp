@@ -8,8 +8,9 @@
 // prefilter_plan: mirror level 0 first, then the rough levels), and step(budget) computes rows
 // until the next row would exceed `budget` source reads ("taps"); a row costs
 //     n_l           taps on a mirror level 0 (one read per texel),
-//     n_l S_l T_l   taps on a convolved level (S_l samples kept after dropping n.l <= 0, T_l = 2
-//                   for trilinear reads, 1 for nearest),
+//     n_l (S_l T_l + ceil(P_l / 8))   taps on a convolved level (S_l samples kept after dropping
+//                   n.l <= 0, T_l = 2 for trilinear reads, 1 for nearest; P_l the peaks of the
+//                   fast filter's split at that level, bake/prefilter_peaks.hpp, eight to a tap),
 // so the cost of a call is bounded by max(budget, the dearest row) and proportional to the taps it
 // reports (bench/bench_prefilter.cpp, BM_prefilter_update_step). Every row is computed by exactly
 // the operations prefilter uses (the same tables, the same kernel, the same row order of
@@ -19,7 +20,8 @@
 // Source changes. set_source(c) restarts the pass on the new source (the rows already computed
 // belong to the old one); result() keeps returning the last finished chain until the new pass
 // finishes, so a renderer always reads a complete chain (double buffering). The sample tables are
-// rebuilt only when the source's size or mip count changes (they depend on nothing else).
+// rebuilt only when the source's size or mip count changes (they depend on nothing else); the
+// fast filter's peaks (bake/prefilter_peaks.hpp) are split again from each new source.
 //
 // Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
 // level) and pack it into the kernel's layout (passes over its texels); the last step of a pass assembles the chain's cubemap
@@ -64,8 +66,15 @@ public:
     void set_source(const cubemap<float>& source) {
         const bool same_shape = source_ && source_->size(0) == source.size(0) && source_->levels() == source.levels();
         source_ = source;
-        src_ = detail::pack_cube(*source_);
+        serial_executor ex;
+        src_.emplace(*source_, opt_, ex);
         if (!same_shape) plan_levels();
+        else // the tables stay; the peaks of the fast filter's split belong to the source
+            for (std::size_t k = 0; k < levels_.size(); ++k)
+                if (!levels_[k].mirror) {
+                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
+                    levels_[k].taps_per_row = convolved_row_taps(levels_[k]);
+                }
         level_ = 0;
         row_ = 0;
         pass_done_ = false;
@@ -120,14 +129,22 @@ public:
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
 
 private:
+    /// Peak evaluations counted as one tap in the budget (bake/prefilter_peaks.hpp: about ten
+    /// vectorised float operations against a bilinear tap's rotation, face selection and reads).
+    static constexpr std::size_t peak_per_tap = 8;
     struct level_work {
         int n = 1;
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
         detail::prefilter_base_read base{};  ///< the mirror level's read
-        detail::tap_table taps{};            ///< a convolved level's taps
+        detail::prefilter_cube_level conv{}; ///< a convolved level's taps and peaks
         std::uint64_t taps_per_row = 1;
         std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
     };
+
+    static std::uint64_t convolved_row_taps(const level_work& lw) noexcept {
+        return std::max<std::uint64_t>(
+            1, std::uint64_t(lw.n) * (lw.conv.taps.w.size() + (lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap));
+    }
 
     void plan_levels() {
         const int base = detail::prefilter_base_size(*source_, opt_.base_size);
@@ -144,11 +161,8 @@ private:
                 lw.base = detail::prefilter_base_mode(*source_, lw.n, lp.trilinear);
                 lw.taps_per_row = std::uint64_t(lw.n);
             } else {
-                sphere_sample_table<float> table =
-                    make_ld_table_for<float, Lobe>(*source_, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight);
-                table.trilinear = lp.trilinear;
-                lw.taps = detail::make_taps(table, int(src_.levels.size()));
-                lw.taps_per_row = std::max<std::uint64_t>(1, std::uint64_t(lw.n) * table.size() * (lp.trilinear ? 2u : 1u));
+                lw.conv = src_->level(*source_, lp);
+                lw.taps_per_row = convolved_row_taps(lw);
             }
             lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
             levels_.push_back(std::move(lw));
@@ -162,7 +176,7 @@ private:
             for (std::size_t r = begin + b; r < begin + e; ++r) {
                 vec3<float>* out = lw.texels.data() + r * std::size_t(n);
                 if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
-                else detail::convolve_row(src_, lw.taps, int(r) / n, int(r) % n, n, out);
+                else src_->row(lw.conv, r, n, out);
             }
         });
     }
@@ -183,7 +197,7 @@ private:
 
     prefilter_options opt_;
     std::optional<cubemap<float>> source_;
-    detail::packed_cube src_{};
+    std::optional<detail::prefilter_cube_source<Lobe, float>> src_;
     std::vector<prefilter_level> plan_;
     std::vector<level_work> levels_;
     int first_size_ = 1;

@@ -1,0 +1,349 @@
+#pragma once
+// ibl/bake/prefilter_peaks.hpp — the fast filter's peak split: the brightest texels of a cubemap
+// source are taken out of what the tap set reads and added back exactly, texel by texel, through
+// the closed-form GGX LD kernel (host only). prefilter() runs it with prefilter_method::fast and
+// prefilter_options::peaks.enabled (the default) on a cubemap source and the GGX lobe.
+//
+// Why. A tap set of N samples per texel reads the source at the lods of its samples' shares of
+// the sphere; a light much smaller than those footprints and much brighter than its surround (a
+// sun 10^4 times the sky, a studio's lamps) is then smeared over the footprints or missed between
+// samples, and the filtered level shows it as blotches. The error grows with the light's contrast,
+// not with the smoothness of the rest: without its sun the built-in sky filters to 1-4 % relative
+// RMSE with 16 samples, with it to 40-300 % (docs/ibl-bake.md, "Fast filter"). The split removes
+// that dependence:
+//
+//     S = B + P,   LD[S] = LD[B] + LD[P],
+//
+// with B the source whose texels above a luminance threshold T are scaled down to luminance T
+// (the colour kept) and P the remainder, non-zero on at most max_peaks level-0 texels. B has a
+// bounded contrast (its largest luminance is T) and goes through the tap set; P is integrated
+// exactly: LD of a texel of energy E_j = Omega_j P_j (Omega_j its exact solid angle) at direction
+// d_j is E_j K(R.d_j) / integral K, with the LD kernel of the chain's weight (bake/prefilter.hpp)
+// in closed form. With N = V = R, c = R.l and q = ((1 - c) + alpha^2 (1 + c)) / 2:
+//
+//     K(c) = D(h) / 4 w(c) = alpha^2 w(c) / (4 pi q^2),    w = c (n.l) or G1(c) (ld_weight::g1),
+//
+// for c > 0 (0 beyond the hemisphere), and integral K over the hemisphere is the fast filter's
+// radial quadrature total (bake/prefilter_fast.hpp). The kernel is evaluated at the texel's
+// centre direction; for that to be the texel's integral within a percent, the peaks of output
+// level l are merged into the texels of the source mip m_l whose angular size is at most the
+// kernel's full width at half maximum over `footprint` and at most max_merge_angle (GGX: FWHM
+// 2.57 alpha, so level 1 at r = 0.2 merges 2 x 2 texels of a 256^2 source): a merged peak
+// carries the summed energy at the luminance-energy centroid of its texels. The threshold is
+//
+//     T = max(ratio * mean luminance, luminance of the (max_peaks + 1)-th brightest texel),
+//
+// so a source with nothing above ratio times its mean has no peaks and filters exactly as without
+// the split, and the cost of the exact part is bounded: at most max_peaks kernel evaluations per
+// output texel (fewer after the merge; peaks behind a row's hemisphere are skipped per row).
+// Each evaluation is about ten float operations, vectorised over a face row.
+//
+// Determinism: the peak lists depend only on the source and the options; each output texel adds
+// its peaks in list order after the tap sum, the same operations in prefilter and
+// prefilter_update.
+
+#include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
+#include <algorithm>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <tuple>
+#include <vector>
+
+#include "../brdf/ggx.hpp"
+#include "../core/color.hpp"
+#include "../core/constants.hpp"
+#include "../core/executor.hpp"
+#include "../core/vec.hpp"
+#include "../env/cube_geometry.hpp"
+#include "../env/cubemap.hpp"
+#include "../runtime/ld_weight.hpp"
+#include "../sampling/lobe.hpp"
+#include "prefilter_fast.hpp"
+
+namespace ibl {
+
+/// The peak split of the fast filter (header comment). Used by prefilter_method::fast on cubemap
+/// sources with the GGX lobe; ignored otherwise.
+struct peak_split_options {
+    bool enabled = true;
+    /// Luminance threshold as a multiple of the source's mean luminance (solid-angle weighted).
+    double ratio = 16.0;
+    /// At most this many level-0 texels are peaks (the threshold rises to keep it).
+    std::uint32_t max_peaks = 1024;
+    /// A merged peak's texel is at most the kernel's full width at half maximum / footprint, and
+    /// at most max_merge_angle radians (the rough levels' kernels are wide but not smooth at the
+    /// horizon, where n.l cuts them off).
+    double footprint = 6.0;
+    double max_merge_angle = 1.0 / 16.0;
+};
+
+/// One peak: its direction (unit) and its energy (Omega times the radiance above the threshold).
+struct cube_peak {
+    vec3<float> dir{0.f, 0.f, 1.f};
+    vec3<double> energy{0.0};
+    double weight = 0.0; ///< the luminance energy behind dir (the merge's centroid weight)
+    int face = 0, x = 0, y = 0;
+};
+
+/// The split of a source (header comment): the base the tap set reads and the level-0 peaks.
+template <class T> struct cube_peak_split {
+    cubemap<T> base{1};
+    std::vector<cube_peak> peaks; ///< level-0 texels, ordered by face, row, column
+    double mean_luminance = 0.0, threshold = 0.0;
+    [[nodiscard]] bool empty() const noexcept { return peaks.empty(); }
+};
+
+/// Splits a cubemap source (with its mip chain) at T = max(ratio mean, the (max_peaks + 1)-th
+/// brightest luminance). With no texel above T the base is left empty (base.size() == 1 and no
+/// peaks): the caller reads the source itself. Non-finite texels count as 0.
+///
+/// Cost: one pass over level 0 (luminance), a selection only when more than max_peaks texels are
+/// above ratio times the mean, a copy of the source, and the mips patched where peaks were taken
+/// out: a level whose face is half its finer level's (the box filter nests) loses, per texel,
+/// the peaks' energy over its exact solid angle; any other chain is rebuilt (generate_mips).
+template <class T, class Executor = serial_executor>
+cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_options& opt, Executor&& ex = Executor{}) {
+    cube_peak_split<T> s;
+    if (!opt.enabled) return s;
+    const int n = src.size(0);
+    const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
+    std::vector<float> lum(count);
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const float l = float(luminance(src.texel(f, x, y, 0)));
+                lum[cube_texel_index(f, x, y, n)] = std::isfinite(l) && l > 0.f ? l : 0.f;
+            }
+    // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
+    // so a chain down to 1 x 1 gives it in six reads; otherwise level 0 by texel solid angles.
+    double acc = 0.0;
+    const int top = src.levels() - 1;
+    if (src.size(top) == 1) {
+        for (int f = 0; f < 6; ++f) {
+            const double l = double(luminance(src.texel(f, 0, 0, top)));
+            acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
+        }
+        s.mean_luminance = acc / 6.0;
+    } else {
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x) acc += double(lum[cube_texel_index(f, x, y, n)]) * cube_texel_solid_angle<double>(x, y, n);
+        s.mean_luminance = acc / four_pi_v<double>;
+    }
+    double t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * s.mean_luminance : 0.0;
+    std::size_t above = 0;
+    for (float l : lum) above += double(l) > t ? 1 : 0;
+    if (above > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
+        std::vector<float> sorted(lum);
+        const std::size_t k = count - 1 - std::size_t(opt.max_peaks);
+        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+        t = std::max(t, double(sorted[k]));
+    }
+    s.threshold = t;
+    if (!(t > 0.0)) return s;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x) {
+                const float l = lum[cube_texel_index(f, x, y, n)];
+                if (!(double(l) > t)) continue;
+                const vec3<double> v(src.texel(f, x, y, 0));
+                const double om = cube_texel_solid_angle<double>(x, y, n);
+                cube_peak p;
+                p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
+                p.energy = v * ((1.0 - t / double(l)) * om);
+                p.weight = (double(l) - t) * om;
+                p.face = f, p.x = x, p.y = y;
+                s.peaks.push_back(p);
+            }
+    if (s.peaks.empty()) return s;
+    s.base = src;
+    for (const cube_peak& p : s.peaks) {
+        vec3<T>& v = s.base.texel_ref(p.face, p.x, p.y, 0);
+        v = vec3<T>(vec3<double>(v) * (t / double(lum[cube_texel_index(p.face, p.x, p.y, n)])));
+    }
+    bool nested = true;
+    for (int l = 1; l < src.levels(); ++l) nested = nested && src.size(l - 1) == 2 * src.size(l);
+    if (!nested) {
+        s.base.generate_mips(ex);
+        return s;
+    }
+    for (int l = 1; l < src.levels(); ++l) {
+        const int m = src.size(l);
+        for (const cube_peak& p : s.peaks) {
+            const int cx = p.x >> l, cy = p.y >> l;
+            vec3<T>& v = s.base.texel_ref(p.face, cx, cy, l);
+            const vec3<double> d = p.energy / cube_texel_solid_angle<double>(cx, cy, m);
+            v = vec3<T>(max(vec3<double>(v) - d, vec3<double>(0.0)));
+        }
+    }
+    s.base.update_borders();
+    return s;
+}
+
+/// The peaks merged into the texels of source mip m (face size n >> m): summed energy at the
+/// luminance-energy centroid, in face, row, column order of the merged texels.
+inline std::vector<cube_peak> merge_cube_peaks(const std::vector<cube_peak>& peaks, int mip) {
+    if (mip <= 0) return peaks;
+    std::map<std::tuple<int, int, int>, std::size_t> at;
+    std::vector<cube_peak> out;
+    std::vector<vec3<double>> centroid;
+    for (const cube_peak& p : peaks) {
+        const auto key = std::make_tuple(p.face, p.y >> mip, p.x >> mip);
+        auto it = at.find(key);
+        if (it == at.end()) {
+            it = at.emplace(key, out.size()).first;
+            cube_peak q;
+            q.face = p.face, q.x = p.x >> mip, q.y = p.y >> mip;
+            q.energy = vec3<double>(0.0);
+            out.push_back(q);
+            centroid.push_back(vec3<double>(0.0));
+        }
+        cube_peak& q = out[it->second];
+        q.energy += p.energy;
+        q.weight += p.weight;
+        centroid[it->second] += p.weight * vec3<double>(p.dir);
+    }
+    std::vector<cube_peak> sorted;
+    for (const auto& [key, k] : at) {
+        cube_peak q = out[k];
+        const double len = length(centroid[k]);
+        if (len > 0.0) q.dir = vec3<float>(centroid[k] / len);
+        sorted.push_back(q);
+    }
+    return sorted;
+}
+
+/// The LD kernel's full width at half maximum of the GGX lobe at roughness r (radians): 2 theta
+/// with K(theta) = K(0) / 2, from q(theta)^2 = 2 q(0)^2 (the n.l factor ignored), at most pi.
+inline double ggx_ld_fwhm(double roughness) noexcept {
+    const double a2 = std::pow(std::max(alpha_from_roughness(std::clamp(roughness, 0.0, 1.0)), 1e-4), 2.0);
+    if (a2 >= 1.0) return pi_v<double>;
+    const double one_minus_c = 2.0 * (std::sqrt(2.0) - 1.0) * a2 / (1.0 - a2);
+    return std::min(pi_v<double>, 2.0 * std::acos(std::max(-1.0, 1.0 - one_minus_c)));
+}
+
+/// The source mip whose texels merge the peaks of a level at roughness r: the coarsest mip m of an
+/// n0-texel level 0 (at most max_mip) whose texel at the face centre, 2 / (n0 >> m) radians, is at
+/// most min(fwhm / footprint, max_angle).
+inline int peak_merge_mip(double roughness, int n0, int max_mip, double footprint, double max_angle) noexcept {
+    const double want = std::min(ggx_ld_fwhm(roughness) / std::max(footprint, 1.0), max_angle);
+    int m = 0;
+    while (m < max_mip && (n0 >> (m + 1)) >= 1 && 2.0 / double(n0 >> (m + 1)) <= want) ++m;
+    return m;
+}
+
+/// The peaks of one output level ready for the row kernel: directions and energies pre-scaled by
+/// alpha^2 / (4 pi integral K), and per peak the cosine beyond which it lies behind a row.
+struct peak_level {
+    std::vector<float> px, py, pz, er, eg, eb;
+    std::vector<float> lum; ///< luminance of (er, eg, eb): the row cut's bound
+    float a2 = 0.f, half_a2 = 0.f;
+    float floor = 0.f; ///< the cut's floor: 1e-2 times the source's mean luminance
+    bool g1 = false;
+    [[nodiscard]] std::size_t size() const noexcept { return px.size(); }
+};
+
+/// Builds a level's peak list: the split's peaks merged at peak_merge_mip, with the kernel of the
+/// GGX lobe at roughness r and the LD weight.
+inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
+                                  ld_weight weight, double footprint, double max_angle, double mean_luminance) {
+    peak_level pl;
+    if (peaks.empty()) return pl;
+    const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
+    const double a = std::max(alpha_from_roughness(r), 1e-4), a2 = a * a;
+    const double norm = 2.0 * pi_v<double> * detail::make_fast_radial_cdf<ggx_lobe>(r, weight).total;
+    if (!(norm > 0.0)) return pl;
+    const double scale = a2 / (4.0 * pi_v<double> * norm);
+    const int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
+    for (const cube_peak& p : merge_cube_peaks(peaks, mip)) {
+        pl.px.push_back(p.dir.x), pl.py.push_back(p.dir.y), pl.pz.push_back(p.dir.z);
+        pl.er.push_back(float(p.energy.x * scale)), pl.eg.push_back(float(p.energy.y * scale)),
+            pl.eb.push_back(float(p.energy.z * scale));
+        pl.lum.push_back(float(luminance(p.energy) * scale));
+    }
+    pl.floor = float(1e-2 * mean_luminance);
+    pl.a2 = float(a2);
+    pl.half_a2 = float(0.5 * a2);
+    pl.g1 = weight == ld_weight::g1;
+    return pl;
+}
+
+namespace detail {
+
+/// Lanes of the peak kernel (a face row in chunks of this many texels, the tail padded).
+inline constexpr int peak_lanes = 16;
+
+/// Adds the peaks of a level to row y of face `face` of its n x n output: out[x] += sum_j
+/// E_j K(R_x . d_j) / integral K (header comment), the peaks in list order. Per row, a peak is
+/// skipped when it lies beyond the hemisphere of every texel of the row, or when its largest
+/// contribution to the row times the number of peaks is below 1e-3 of the row's darkest tap-set
+/// result (at least 1e-2 of the source's mean luminance): the skipped peaks together change no
+/// texel of the row by more than 1e-3 relative.
+inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<float>* out) {
+    if (pl.size() == 0) return;
+    // The row's bounding cone: its middle texel's direction and the larger angle to its ends.
+    const vec3<float> mid = normalize(cube_texel_direction<float>(face, n / 2, y, n));
+    const vec3<float> e0 = normalize(cube_texel_direction<float>(face, 0, y, n));
+    const vec3<float> e1 = normalize(cube_texel_direction<float>(face, n - 1, y, n));
+    const float cos_half = std::min(dot(mid, e0), dot(mid, e1));
+    const float sin_half = std::sqrt(std::max(0.f, 1.f - cos_half * cos_half));
+    const float ha2 = pl.half_a2, a2 = pl.a2, one_minus_a2 = 1.f - pl.a2;
+    float darkest = luminance(out[0]);
+    for (int x = 1; x < n; ++x) darkest = std::min(darkest, luminance(out[x]));
+    const float cut = 1e-3f * std::max(darkest, pl.floor) / float(pl.size());
+    std::vector<std::uint32_t> live;
+    live.reserve(pl.size());
+    for (std::size_t j = 0; j < pl.size(); ++j) {
+        // The largest cosine between the peak and a texel of the row: cos(max(0, a - half)), a
+        // the angle to the middle texel (1 inside the cone); behind the row when it is <= 0.
+        const float ca = std::clamp(mid.x * pl.px[j] + mid.y * pl.py[j] + mid.z * pl.pz[j], -1.f, 1.f);
+        const float c_max = ca >= cos_half ? 1.f : ca * cos_half + std::sqrt(std::max(0.f, 1.f - ca * ca)) * sin_half;
+        if (!(c_max > 0.f)) continue;
+        const float qb = 0.5f * (1.f - c_max) + ha2 * (1.f + c_max);
+        if (pl.lum[j] / (qb * qb) < cut) continue; // w(c) <= 1 for both weights
+        live.push_back(std::uint32_t(j));
+    }
+    if (live.empty()) return;
+    constexpr int W = peak_lanes;
+    for (int x0 = 0; x0 < n; x0 += W) {
+        float dx[W], dy[W], dz[W], ar[W], ag[W], ab[W];
+        for (int k = 0; k < W; ++k) {
+            const vec3<float> d = x0 + k < n ? normalize(cube_texel_direction<float>(face, x0 + k, y, n)) : vec3<float>(0.f);
+            dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
+            ar[k] = ag[k] = ab[k] = 0.f;
+        }
+        for (const std::uint32_t j : live) {
+            const float px = pl.px[j], py = pl.py[j], pz = pl.pz[j];
+            const float er = pl.er[j], eg = pl.eg[j], eb = pl.eb[j];
+            if (pl.g1) {
+                for (int k = 0; k < W; ++k) {
+                    const float c = dx[k] * px + dy[k] * py + dz[k] * pz;
+                    const float cp = c > 0.f ? c : 0.f;
+                    const float q = 0.5f * (1.f - cp) + ha2 * (1.f + cp);
+                    const float g = 2.f / (cp + std::sqrt(a2 + one_minus_a2 * cp * cp)); // G1 / n.l
+                    const float kk = cp * g / (q * q);
+                    ar[k] += er * kk, ag[k] += eg * kk, ab[k] += eb * kk;
+                }
+            } else {
+                for (int k = 0; k < W; ++k) {
+                    const float c = dx[k] * px + dy[k] * py + dz[k] * pz;
+                    const float cp = c > 0.f ? c : 0.f;
+                    const float q = 0.5f * (1.f - cp) + ha2 * (1.f + cp);
+                    const float kk = cp / (q * q);
+                    ar[k] += er * kk, ag[k] += eg * kk, ab[k] += eb * kk;
+                }
+            }
+        }
+        for (int k = 0; k < W && x0 + k < n; ++k) out[x0 + k] += vec3<float>(ar[k], ag[k], ab[k]);
+    }
+}
+
+} // namespace detail
+
+} // namespace ibl
+
+#endif // IBL_DETAIL_CXX20
