@@ -46,8 +46,20 @@ struct probe_json {
     /// A volume: sets box or sphere, returns whether it is a sphere.
     bool volume(const json_value& v, const std::string& where, ibl::probe_box<double>& box, ibl::probe_sphere<double>& ball) const {
         if (const json_value* b = v.find("box")) {
-            box = ibl::probe_box<double>::axis_aligned(vec(need(*b, "min", where + ".box"), where + ".box.min"),
-                                                       vec(need(*b, "max", where + ".box"), where + ".box.max"));
+            const std::string w = where + ".box";
+            if (b->find("min")) {
+                box = ibl::probe_box<double>::axis_aligned(vec(need(*b, "min", w), w + ".min"), vec(need(*b, "max", w), w + ".max"));
+                return false;
+            }
+            // oriented: center, half_extents, axes (orthonormal as the bake wrote them)
+            box.center = vec(need(*b, "center", w), w + ".center");
+            box.half = vec(need(*b, "half_extents", w), w + ".half_extents");
+            const json_value& axes = need(*b, "axes", w);
+            if (!axes.is_array() || axes.values.size() != 3) fail(w + ".axes", "expected 3 axes");
+            for (std::size_t i = 0; i < 3; ++i) {
+                box.axis[i] = vec(axes.values[i], w + ".axes");
+                if (!(std::fabs(glm::length(box.axis[i]) - 1.0) <= 1e-6)) fail(w + ".axes", "not unit vectors");
+            }
             return false;
         }
         const json_value& s = need(v, "sphere", where);

@@ -51,6 +51,14 @@ void json_volume(json_writer& j, const probe_volume_desc& v) {
         j.key("sphere").begin_object().key("center");
         json_vec3(j, v.center);
         j.key("radius").value(v.radius).end_object();
+    } else if (v.oriented) {
+        j.key("box").begin_object().key("center");
+        json_vec3(j, v.center);
+        j.key("half_extents");
+        json_vec3(j, v.half_extents);
+        j.key("axes").begin_array();
+        for (const auto& a : v.axes) json_vec3(j, a);
+        j.end_array().end_object();
     } else {
         j.key("box").begin_object().key("min");
         json_vec3(j, v.min);

@@ -262,6 +262,61 @@ TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     CHECK(e(0, dvec3(0, 1, 0)).x > e(0, dvec3(0, -1, 0)).x);
 }
 
+TEST_CASE("probes: oriented boxes (center, half_extents, axes)") {
+    // One probe, the proxy a box turned 30 degrees about y (axes slightly off unit length and
+    // perpendicularity: the reader orthonormalises them), the influence an oriented box with the
+    // world's axes. probes.json carries the oriented form; `local` answers with the oriented proxy.
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    std::ofstream(b.s / "oriented.json") << R"({"probes": [
+  {"input": "a.exr", "position": [0.5, 0, 0],
+   "proxy": {"box": {"center": [0, 0, 0], "half_extents": [4, 2, 3],
+                     "axes": [[0.86603, 0, -0.5], [0, 1, 0], [0.5, 0, 0.86602]]}},
+   "influence": {"box": {"center": [0, 0, 0], "half_extents": [5, 3, 4]}, "fade": 1}}]})";
+    const std::string out = b.s / "oriented_set";
+    REQUIRE(shell(tool + " --probes " + b.s / "oriented.json" + " --out " + out + " --size 16 --quality low --threads 2 >/dev/null 2>" +
+                  b.s / "oriented_err.txt") == 0);
+    const ibl_examples::json_value j = ibl_examples::parse_json(slurp(out + "/probes.json"));
+    const ibl_examples::json_value& pr = j.find("probes")->values.at(0);
+    const ibl_examples::json_value* box = pr.find("proxy")->find("box");
+    REQUIRE(box);
+    CHECK(!box->find("min"));
+    REQUIRE(box->find("axes"));
+    const double c30 = std::sqrt(3.0) / 2.0;
+    const dvec3 ax0(box->find("axes")->values.at(0).values.at(0).number, box->find("axes")->values.at(0).values.at(1).number,
+                    box->find("axes")->values.at(0).values.at(2).number);
+    CHECK(glm::length(ax0) == doctest::Approx(1.0).epsilon(1e-12));
+    CHECK(ax0.x == doctest::Approx(c30).epsilon(1e-5));
+    CHECK(box->find("half_extents")->values.at(2).number == 3);
+    REQUIRE(pr.find("influence")->find("box")->find("axes"));
+    CHECK(pr.find("influence")->find("box")->find("axes")->values.at(1).values.at(1).number == 1.0);
+
+    ibl::probe_box<double> proxy;
+    proxy.center = dvec3(0.0);
+    proxy.half = dvec3(4, 2, 3);
+    proxy.axis[0] = dvec3(c30, 0, -0.5);
+    proxy.axis[1] = dvec3(0, 1, 0);
+    proxy.axis[2] = dvec3(0.5, 0, c30);
+    const ibl::probe_box<double> aligned = ibl::probe_box<double>::axis_aligned(dvec3(-4, -2, -3), dvec3(4, 2, 3));
+    const std::vector<ibl::cubemap<float>> layers = decoded_layers(out);
+    REQUIRE(layers.size() == 1);
+    const ibl::specular_lookup_desc desc = ibl::specular_lookup_desc::textbook();
+    const dvec3 p(-1.5, 0.5, 1.0), c(0.5, 0, 0), d = glm::normalize(dvec3(-0.8, 0.1, 0.3));
+    const double r = 0.2;
+    const auto corrected = [&](const ibl::probe_box<double>& bx) {
+        const auto l = ibl::parallax_correct(bx, c, p, d);
+        REQUIRE(l.hit);
+        return dvec3(ibl::specular_lookup(layers[0], fvec3(l.direction), float(ibl::corrected_roughness(r, l.d_shading, l.d_probe)), desc));
+    };
+    std::ofstream(b.s / "oq.txt") << "local -1.5 0.5 1 -0.8 0.1 0.3 0.2\n";
+    REQUIRE(shell(tool + " --lookup " + out + " <" + b.s / "oq.txt" + " >" + b.s / "oa.txt" + " 2>&1") == 0);
+    const dvec3 got = parse3(slurp(b.s / "oa.txt"));
+    check_close(got, corrected(proxy), 1e-5, "oriented proxy");
+    // the orientation matters here: the axis-aligned box of the same extents gives another answer
+    const dvec3 other = corrected(aligned);
+    CHECK(std::fabs(other.x - got.x) + std::fabs(other.y - got.y) > 1e-3);
+}
+
 TEST_CASE("probes: lookup errors on a probe set") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
@@ -298,6 +353,19 @@ TEST_CASE("probes: malformed probe files name the probe and the key") {
         {one(good + box + R"(, "influence": {"sphere": {"center": [0, 0, 0], "radius": 1}})"), "probes[1].influence: missing \"fade\""},
         {one(good + box + ", " + infl + R"(, "priority": 0.5)"), "probes[1].priority: expected an integer"},
         {one(good + box + ", " + infl + R"(, "colour": 1)"), "probes[1].colour: unknown key"},
+        {one(good + R"("proxy": {"box": {"min": [0, 0, 0], "center": [1, 1, 1], "half_extents": [1, 1, 1]}}, )" + infl),
+         "probes[1].proxy.box: both min/max and center/half_extents/axes"},
+        {one(good + R"("proxy": {"box": {"center": [1, 1, 1]}}, )" + infl), "probes[1].proxy.box: missing \"half_extents\""},
+        {one(good + R"("proxy": {"box": {"center": [1, 1, 1], "half_extents": [1, -1, 1]}}, )" + infl),
+         "probes[1].proxy.box.half_extents[1]: must be >= 0"},
+        {one(good + box + R"(, "influence": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0, 2, 0], [0, 0, 1]]}, "fade": 1})"),
+         "probes[1].influence.box.axes[1]: not a unit vector"},
+        {one(good + box + R"(, "influence": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0.6, 0.8, 0], [0, 0, 1]]}, "fade": 1})"),
+         "probes[1].influence.box.axes: axes[0] and axes[1] are not perpendicular"},
+        {one(good + R"("proxy": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0, 1, 0]]}}, )" + infl),
+         "probes[1].proxy.box.axes: expected 3 axes"},
+        {one(good + R"("proxy": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "rotation": 30}}, )" + infl),
+         "probes[1].proxy.box.rotation: unknown key"},
         {R"({"probes": []})", "probes: no probes"},
         {many, "65 probes, at most 64"},
         {R"([1, 2])", "expected an object"},
