@@ -317,6 +317,27 @@ TEST_CASE("probes: oriented boxes (center, half_extents, axes)") {
     CHECK(std::fabs(other.x - got.x) + std::fabs(other.y - got.y) > 1e-3);
 }
 
+TEST_CASE("probes: options that do not apply to a probe set are refused") {
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    const std::string base = tool + " --probes " + b.s / "probes.json" + " --out " + b.s / "refused_out" + " --size 16 --quality low ";
+    for (const std::string opt : {"--sheen", "--runtime taps2", "--runtime=lobe", "--preset filament", "--specular-lookup accurate",
+                                  "--extract-sun on", "--irradiance-size 8", "--dfg-layout uniform", "--sh-bands 3",
+                                  "--sh-window none", "--lut-size 16", "--layout faces", "--checks full", "--verbose",
+                                  "--compare-full", "--strict"}) {
+        const std::string name = opt.substr(0, opt.find_first_of(" ="));
+        CHECK_MESSAGE(shell(base + opt + " 2>" + b.s / "refused.txt" + " >/dev/null") == 2, opt);
+        const std::string err = slurp(b.s / "refused.txt");
+        CHECK_MESSAGE(err.find(name + " does not apply to --probes") != std::string::npos, err);
+        CHECK(!std::filesystem::exists(b.s / "refused_out"));
+    }
+    // the options a probe set uses are accepted (a usage error would be exit status 2)
+    CHECK(shell(base + "--levels 3 --threads 2 --policy filament --ld-weight g1 --prefilter fast --mirror --input-layout auto "
+                       "--max-input-pixels 100000 --ktx2-format rgba32f --ktx2-zstd 0 --ktx2-quality fast --quiet >/dev/null 2>" +
+                b.s / "accepted.txt") == 0);
+    CHECK(std::filesystem::exists(b.s / "refused_out" + "/probes.ktx2"));
+}
+
 TEST_CASE("probes: lookup errors on a probe set") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
