@@ -17,6 +17,7 @@
 #include "io/image_io.hpp"
 #include "io/json_value.hpp"
 #include "io/ktx2.hpp"
+#include "stages/probe_bake.hpp"
 
 namespace ibl_bake {
 
@@ -78,7 +79,18 @@ using query_text::unit;
 
 bool is_probe_set_folder(const std::string& dir) {
     std::error_code ec;
-    return std::filesystem::is_regular_file(dir + "/probes.json", ec) && !std::filesystem::exists(dir + "/report.json", ec);
+    if (!std::filesystem::is_regular_file(dir + "/probes.json", ec)) return false;
+    if (!std::filesystem::exists(dir + "/report.json", ec)) return true; // a probe set baked before it wrote a report
+    // both files: the report says which bake wrote the folder last (a folder keeps the files a
+    // bake does not write, so a single bake over a probe set leaves probes.json behind)
+    try {
+        const std::vector<unsigned char> text = read_file(dir + "/report.json");
+        const json_value r = ibl_examples::parse_json(std::string(text.begin(), text.end()));
+        const json_value* f = r.is_object() ? r.find("format") : nullptr;
+        return f && f->is_string() && f->string == probe_report_format;
+    } catch (const std::exception&) {
+        return false; // an unreadable report: the single bake's loader says what is wrong with it
+    }
 }
 
 probe_set_folder load_probe_set(const std::string& dir) {

@@ -212,6 +212,53 @@ TEST_CASE("probes: bake writes a cubemap array and its metadata") {
     for (int c = 0; c < 3; ++c) CHECK(e[c] == doctest::Approx(ibl::pi_v<double> * constant_b[c]).epsilon(1e-3));
 }
 
+TEST_CASE("probes: report.json per probe") {
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    CHECK(b.stdout_text.find("report.json") != std::string::npos);
+    const ibl_examples::json_value r = ibl_examples::parse_json(slurp(b.out + "/report.json"));
+    REQUIRE(r.find("format"));
+    CHECK(r.find("format")->string == "ibl-bake probe-set report");
+    CHECK(r.find("settings")->find("face_size")->number == 16);
+    CHECK(r.find("settings")->find("quality")->string == "low");
+    CHECK(r.find("time_ms")->number > 0.0);
+    CHECK(r.find("ktx2")->find("bytes")->number == double(read_file(b.out + "/probes.ktx2").size()));
+    const ibl_examples::json_value j = ibl_examples::parse_json(slurp(b.out + "/probes.json"));
+    const std::size_t levels = std::size_t(j.find("levels")->number);
+    const auto& probes = r.find("probes")->values;
+    REQUIRE(probes.size() == 2);
+    for (std::size_t i = 0; i < 2; ++i) {
+        const ibl_examples::json_value& p = probes[i];
+        CAPTURE(i);
+        CHECK(p.find("layer")->number == double(i));
+        CHECK(p.find("input")->string.find(i == 0 ? "a.exr" : "b.hdr") != std::string::npos);
+        CHECK(p.find("input_size")->values.at(0).number == 32);
+        CHECK(p.find("input_size")->values.at(1).number == 16);
+        CHECK(p.find("time_ms")->number > 0.0);
+        const auto& lv = p.find("levels")->values;
+        REQUIRE(lv.size() == levels);
+        for (std::size_t k = 0; k < levels; ++k) {
+            CAPTURE(k);
+            CHECK(lv[k].find("size")->number == double(16 >> k));
+            CHECK(lv[k].find("roughness")->number ==
+                  doctest::Approx(j.find("conventions")->find("level_roughness")->values.at(k).number));
+            CHECK(lv[k].find("texels_compared")->number > 0);
+            const double e = lv[k].find("rel_rmse")->number;
+            CHECK(e >= 0.0);
+            // the constant capture is filtered exactly (half-float storage aside); the pattern's
+            // low-quality chain stays within 10% of its reference
+            CHECK(e < (i == 1 ? 1e-3 : 0.1));
+        }
+        REQUIRE(p.find("ktx2_quantisation"));
+    }
+    // --lookup still takes the folder as a probe set (its report says so)
+    int st = 0;
+    const auto lines = b.lookup("local -2 0 0 0 1 0 0.5\n", &st);
+    CHECK(st == 0);
+    REQUIRE(lines.size() == 1);
+    CHECK(lines[0].find("error") == std::string::npos);
+}
+
 TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
