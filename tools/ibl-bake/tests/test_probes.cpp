@@ -259,6 +259,29 @@ TEST_CASE("probes: report.json per probe") {
     CHECK(lines[0].find("error") == std::string::npos);
 }
 
+TEST_CASE("probes: --lookup tells the bake that wrote a folder last by its report.json") {
+    // A folder keeps the files a bake does not write: a single bake over a probe set leaves
+    // probes.json behind, a probe set over a single bake leaves specular.ktx2; report.json's
+    // "format" says which bake wrote the folder last.
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    const std::string dir = b.s / "mixed";
+    std::filesystem::remove_all(dir);
+    std::filesystem::copy(b.out, dir, std::filesystem::copy_options::recursive);
+    const auto ask = [&](const std::string& q) {
+        std::ofstream(b.s / "mq.txt") << q;
+        shell(tool + " --lookup " + dir + " <" + b.s / "mq.txt" + " >" + b.s / "ma.txt" + " 2>&1");
+        return slurp(b.s / "ma.txt");
+    };
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == std::string::npos);
+    REQUIRE(shell(tool + " --size 16 --quality low --checks none --threads 2 --quiet --out " + dir + " >/dev/null 2>&1") == 0);
+    CHECK(std::filesystem::exists(dir + "/probes.json")); // kept
+    CHECK(ask("specular 0 0 1 0.5\n").find("error") == std::string::npos);
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == 0); // a single bake now: no local queries
+    REQUIRE(shell(tool + " --probes " + b.s / "probes.json" + " --size 16 --quality low --threads 2 --out " + dir + " >/dev/null 2>&1") == 0);
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == std::string::npos);
+}
+
 TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
