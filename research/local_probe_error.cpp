@@ -18,6 +18,11 @@
 //              influence boxes that split the room at x = 0 with 1 m fades (blend_probe_weights)
 // Error: relative RMSE of luminance over the points x directions (floor 1e-3 x the mean truth).
 //
+// Then the same study in the inner-box variant of the room (analytic_room::inner: an opaque
+// 2.4 x 1.1 x 1.8 m block on the floor near the centre, below the capture points): captures and
+// truth both ray cast against it, the proxy is still the room's box (the block is what the proxy
+// does not model); shading points inside the block are left out.
+//
 //   local_probe_error [N]     faces of N^2 (default 256)
 // Regenerate the docs' table: build/release/research/local_probe_error > /tmp/local_probes.md
 
@@ -64,13 +69,9 @@ double lum(const dvec3& v) { return ibl::luminance(v); }
 
 } // namespace
 
-int main(int argc, char** argv) {
-    const int n = argc > 1 ? std::atoi(argv[1]) : 256;
-    if (n < 8 || n > 2048) {
-        std::fprintf(stderr, "usage: local_probe_error [face size 8..2048]\n");
-        return 2;
-    }
-    const ibl::analytic_room<double> room;
+namespace {
+
+void study(const ibl::analytic_room<double>& room, int n) {
     const ibl::probe_box<double> proxy = ibl::probe_box<double>::axis_aligned(room.lo, room.hi);
     const dvec3 centre = 0.5 * (room.lo + room.hi);
     const probe p0 = capture(room, centre, n);
@@ -86,7 +87,7 @@ int main(int argc, char** argv) {
             for (int k = 0; k < 4; ++k) {
                 const dvec3 t((i + 0.5) / 4.0, (j + 0.5) / 3.0, (k + 0.5) / 4.0);
                 const dvec3 lo = room.lo + dvec3(0.6), hi = room.hi - dvec3(0.6);
-                points.push_back(lo + t * (hi - lo));
+                if (!room.inside_inner(lo + t * (hi - lo))) points.push_back(lo + t * (hi - lo));
             }
     const int nd = 16;
     for (int k = 0; k < nd; ++k) { // spherical Fibonacci
@@ -154,5 +155,22 @@ int main(int argc, char** argv) {
     for (std::size_t i = 0; i < truth.size(); ++i) a1.add(one[i], truth[i]), a2.add(two[i], truth[i]);
     std::printf("\nirradiance (SH3): one probe at the centre %.4f, two probes blended %.4f (relative RMSE of luminance)\n",
                 a1.finish().rel_rmse, a2.finish().rel_rmse);
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+    const int n = argc > 1 ? std::atoi(argv[1]) : 256;
+    if (n < 8 || n > 2048) {
+        std::fprintf(stderr, "usage: local_probe_error [face size 8..2048]\n");
+        return 2;
+    }
+    const ibl::analytic_room<double> room;
+    study(room, n);
+    ibl::analytic_room<double> blocked = room;
+    blocked.inner = true;
+    std::printf("\ninner-box variant: a block [%g, %g] x [%g, %g] x [%g, %g] m in the room, not in the proxy\n", blocked.inner_lo.x,
+                blocked.inner_hi.x, blocked.inner_lo.y, blocked.inner_hi.y, blocked.inner_lo.z, blocked.inner_hi.z);
+    study(blocked, n);
     return 0;
 }

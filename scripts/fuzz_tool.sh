@@ -30,6 +30,7 @@ printf '{}' >"$OUT/seeds-scene/empty-object.json"
 printf '{"name":"x","materials":[{"name":"m","metallic":0.5,"roughness_range":[0,1]}]}' >"$OUT/seeds-scene/minimal.json"
 printf '{"probes":[{"input":"a.exr","position":[0,1,0],"proxy":{"box":{"min":[-2,0,-2],"max":[2,3,2]}},"influence":{"box":{"min":[-2,0,-2],"max":[2,3,2]},"fade":0.5}}]}' >"$OUT/seeds-probes/box.json"
 printf '{"probes":[{"input":"a.hdr","position":[0,0,0],"priority":2,"proxy":{"sphere":{"center":[0,0,0],"radius":4}},"influence":{"sphere":{"center":[1,0,0],"radius":3},"fade":1}},{"input":"/abs/b.exr","position":[5,0,0],"proxy":{"box":{"min":[3,-1,-1],"max":[7,1,1]}},"influence":{"sphere":{"center":[5,0,0],"radius":2},"fade":0.25}}]}' >"$OUT/seeds-probes/two.json"
+printf '{"probes":[{"input":"a.exr","position":[0,1,0],"proxy":{"box":{"center":[0,1.5,0],"half_extents":[4,1.5,3],"axes":[[0.8660254037844386,0,-0.5],[0,1,0],[0.5,0,0.8660254037844386]]}},"influence":{"box":{"center":[0,1.5,0],"half_extents":[5,2,4]},"fade":0.5}}]}' >"$OUT/seeds-probes/oriented.json"
 i=0
 while IFS= read -r line; do
     i=$((i + 1))

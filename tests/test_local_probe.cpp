@@ -249,6 +249,54 @@ TEST_CASE("analytic room: traces land on the walls, a capture from a point sees 
     CHECK(ibl::luminance(room.trace(dvec3(room.emitter_x, 1.0, room.emitter_z), dvec3(0, 1, 0))) > 30.0);
 }
 
+TEST_CASE("analytic room, inner-box variant: rays stop at the block, the rest of the room is unchanged") {
+    ibl::analytic_room<double> room;
+    const ibl::analytic_room<double> plain;
+    room.inner = true;
+    // straight down from above the block: its top face, at the block's pattern
+    const dvec3 above(0.3, 2.5, -0.2);
+    const dvec3 top = room.trace(above, dvec3(0, -1, 0));
+    const dvec3 on_top(0.3, room.inner_hi.y, -0.2);
+    CHECK(top.x == doctest::Approx(room.inner_base.x * room.pattern(on_top, 1)).epsilon(1e-12));
+    CHECK(top.y == doctest::Approx(room.inner_base.y * room.pattern(on_top, 1)).epsilon(1e-12));
+    CHECK(top != plain.trace(above, dvec3(0, -1, 0))); // without the block: the floor
+    // towards -x from beside the block (at x = 3): its +X face
+    int face = -1;
+    const double t = room.inner_entry(dvec3(3.0, 0.5, 0.0), dvec3(-1, 0, 0), face);
+    CHECK(face == 1);
+    CHECK(t == doctest::Approx(3.0 - room.inner_hi.x).epsilon(1e-12));
+    // the ray through the block's edge region from a random point outside: it stops at the block
+    // exactly when the block is nearer than the wall; rays that miss it see what the plain room shows
+    std::mt19937_64 rng(5);
+    int blocked = 0, missed = 0;
+    for (int k = 0; k < 2000; ++k) {
+        const dvec3 p(-3.5 + 7.0 * std::uniform_real_distribution<double>(0, 1)(rng), 0.2 + 2.6 * std::uniform_real_distribution<double>(0, 1)(rng),
+                      -2.5 + 7.0 * std::uniform_real_distribution<double>(0, 1)(rng));
+        const dvec3 d = random_unit(rng);
+        if (room.inside_inner(p)) {
+            CHECK(room.trace(p, d) == dvec3(0.0));
+            continue;
+        }
+        int w = -1, f = -1;
+        const double tw = room.exit(p, d, w), ti = room.inner_entry(p, d, f);
+        if (ti > 0.0 && ti < tw) {
+            ++blocked;
+            const dvec3 x = p + ti * d;
+            const int axis = f / 2;
+            CHECK(x[axis] == doctest::Approx(f % 2 ? room.inner_hi[axis] : room.inner_lo[axis]).epsilon(1e-9));
+            for (int a = 0; a < 3; ++a) { // the entry point lies on the block
+                CHECK(x[a] >= room.inner_lo[a] - 1e-9);
+                CHECK(x[a] <= room.inner_hi[a] + 1e-9);
+            }
+        } else {
+            ++missed;
+            CHECK(room.trace(p, d) == plain.trace(p, d));
+        }
+    }
+    CHECK(blocked > 100);
+    CHECK(missed > 100);
+}
+
 TEST_CASE("local probes in the analytic room: parallax correction and distance-based roughness cut the error") {
     // Small and fast (64^2 captures, 12 points x 8 directions, 1024-sample references); the full
     // study with its figures is research/local_probe_error (docs/local_probes.md).

@@ -18,7 +18,8 @@ cases = [("ES 3.00, every function", es, "tests/browser/glsl_check_main.glsl"),
          ("4.50, every function", "#version 450\n", "tests/browser/glsl_check_main.glsl"),
          ("ES 3.00, viewer", es, "tools/viewer/viewer.frag.glsl"),
          ("ES 3.00, numeric grid", es, "tools/viewer/numeric.frag.glsl"),
-         ("ES 3.00, prefilter", es, "tools/viewer/prefilter.frag.glsl")]
+         ("ES 3.00, prefilter", es, "tools/viewer/prefilter.frag.glsl"),
+         ("ES 3.00, room example", es, "tools/viewer/room.frag.glsl")]
 ok = True
 for name, header, main in cases:
     src = header + lib + open(os.path.join(repo, main)).read()

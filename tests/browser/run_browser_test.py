@@ -13,7 +13,8 @@ SwiftShader's WebGL2), compared with the C++.
            shading the files as stored, decoded as a GPU decodes them; lookup_preview): preview.png
            is rendered from the float products, so it holds no compression error.
   screenshot  (not a test) bakes as `preview` does and saves Chromium's screenshot of the
-           interactive viewer to --out (docs/shaders-viewer.png).
+           interactive viewer to --out (docs/shaders-viewer.png); with --page room, the room
+           example (room.html) from --reference's JSON instead (docs/local_probes-room.png).
   prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
            fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 32^2, packed,
            and the fast filter's taps per level) and compares every texel of every convolved level
@@ -25,6 +26,12 @@ SwiftShader's WebGL2), compared with the C++.
            texture, reads every texel with texelFetch into an RGBA32F target, and every value must
            be exactly the library's half (bc6h_decode_block_half). Exit 77 (skipped) where the
            browser lacks EXT_texture_compression_bptc or EXT_color_buffer_float.
+  room     lets tools/viewer/room.html draw the analytic room lit by two local probes (mirror and
+           glossy walls; the left half the distant lookup, the right half parallax-corrected) from
+           `room_reference`'s JSON (the scene, the probes' chains as halves, served as
+           /bake/room_fixtures.json) and compares every pixel's linear RGB with the same pixels
+           shaded by the library in C++ (room_reference.cpp), and the mirror pixels of both halves
+           with the room's true radiance (the corrected half must be the nearer).
   numeric  lets tools/viewer/numeric.frag.glsl evaluate the GLSL functions on a fixed grid of
            inputs and compares them with the same grid evaluated by the library in C++
            (glsl_reference, tests/browser/glsl_reference.cpp); the page uploads the fixtures
@@ -580,6 +587,68 @@ def compare_prefilter(fixtures, result):
     return ok
 
 
+# ---- room comparison ------------------------------------------------------------------------------
+
+def luminance(rgb):
+    return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2]
+
+
+# The room test's bound: half-float rounding of the value (2^-11 relative) plus 2^-14 absolute; the
+# arithmetic and filtering differences measured on SwiftShader use 0.07 of it (docs/local_probes.md).
+ROOM_REL, ROOM_ABS = 2.0 ** -11, 2.0 ** -14
+
+
+def compare_room(fixtures, result, rel, absolute):
+    """Every pixel's linear RGB (rows from the bottom, both halves) against room_reference's, within
+    rel |C++| + absolute; the same pixels tone-mapped to 8 bits (Reinhard, sRGB) within one code;
+    and the mirror pixels against the room's true radiance: the corrected half's relative RMSE of
+    luminance must be below a quarter of the distant lookup's."""
+    w, h = fixtures["width"], fixtures["height"]
+    if (result["width"], result["height"]) != (w, h):
+        raise RuntimeError(f"the page drew {result['width']} x {result['height']}, expected {w} x {h}")
+    vals, expect = result["values"], fixtures["expect"]
+    excluded = set(fixtures["excluded"])
+    worst, worst_at, bad, worst8, compared = 0.0, None, 0, 0, 0
+    hist = {}
+    for i in range(w * h):
+        if i in excluded:
+            continue
+        compared += 1
+        d8 = 0
+        for c in range(3):
+            e, g = expect[3 * i + c], vals[4 * i + c]
+            lim = rel * abs(e) + absolute
+            if not abs(g - e) / lim <= worst:
+                worst, worst_at = abs(g - e) / lim, (i % w, i // w, c, g, e)
+            if not abs(g - e) <= lim:
+                if bad < 5:
+                    print(f"  pixel ({i % w}, {i // w}).{c}: GLSL {g!r} C++ {e!r} |diff| {abs(g - e):.3g} > {lim:.3g}")
+                bad += 1
+            d8 = max(d8, abs(srgb_png(g, 1.0) - srgb_png(e, 1.0)))
+        hist[d8] = hist.get(d8, 0) + 1
+        worst8 = max(worst8, d8)
+    print(f"renderer: {result.get('renderer')}")
+    print(f"pixels compared {compared} of {w * h} ({len(excluded)} excluded: their camera ray meets the room within "
+          f"1e-3 of an edge between two walls)")
+    print(f"linear RGB: worst |diff| / ({rel:g} |C++| + {absolute:g}) {worst:.3g} at pixel ({worst_at[0]}, {worst_at[1]}) "
+          f"channel {worst_at[2]} (GLSL {worst_at[3]:.9g}, C++ {worst_at[4]:.9g}); {bad} values outside")
+    print("8-bit (Reinhard, sRGB) max channel |diff| histogram: " + ", ".join(f"{k}: {hist[k]}" for k in sorted(hist)))
+    # The mirror floor against the truth, per half (the same wall point in both halves).
+    err = {0: [0.0, 0.0], 1: [0.0, 0.0]}
+    for k, i in enumerate(fixtures["mirror"]):
+        half = 1 if i % w >= w // 2 else 0
+        t = luminance(fixtures["mirror_truth"][3 * k:3 * k + 3])
+        g = luminance(vals[4 * i:4 * i + 3])
+        err[half][0] += (g - t) ** 2
+        err[half][1] += t * t
+    rmse = {k: math.sqrt(v[0] / v[1]) if v[1] > 0 else float("inf") for k, v in err.items()}
+    print(f"mirror floor ({len(fixtures['mirror']) // 2} pixels per half) against the true radiance, relative RMSE of "
+          f"luminance: distant lookup {rmse[0]:.4f}, parallax-corrected {rmse[1]:.4f}")
+    ok = bad == 0 and worst8 <= 1 and rmse[1] < 0.25 * rmse[0] and compared > 0.9 * w * h
+    print("PASS" if ok else "FAIL")
+    return ok
+
+
 # ---- BC6H decoder comparison --------------------------------------------------------------------------
 
 BC6H_MODES = {0x02: 3, 0x06: 4, 0x0a: 5, 0x0e: 6, 0x12: 7, 0x16: 8, 0x1a: 9, 0x1e: 10, 0x03: 11, 0x07: 12, 0x0b: 13, 0x0f: 14}
@@ -671,9 +740,10 @@ def compare_bc6h(fixtures, result):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "bc6h", "screenshot"], required=True)
+    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "bc6h", "room", "screenshot"], required=True)
+    ap.add_argument("--page", choices=["viewer", "room"], default="viewer", help="screenshot: which page")
     ap.add_argument("--tool", help="ibl-bake (preview)")
-    ap.add_argument("--reference", help="glsl_reference (numeric, prefilter), bc6h_fixtures (bc6h)")
+    ap.add_argument("--reference", help="glsl_reference (numeric, prefilter), bc6h_fixtures (bc6h), room_reference (room)")
     ap.add_argument("--chromium", default="chromium")
     ap.add_argument("--repo", default=os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
     ap.add_argument("--size", default="32", help="face size of the preview test's bake")
@@ -690,7 +760,7 @@ def main():
     try:
         bake_dir = os.path.join(work, "bake")
         os.makedirs(bake_dir)
-        if a.mode in ("preview", "screenshot"):
+        if a.mode in ("preview", "screenshot") and a.page == "viewer":
             subprocess.run([a.tool, "--size", a.size, "--quality", a.quality, "--out", bake_dir, "--quiet"] +
                            (["--input", a.input] if a.input else []) + a.bake_args.split(), check=True,
                            stdout=subprocess.DEVNULL)
@@ -701,6 +771,9 @@ def main():
             prefilter_fixtures = subprocess.run([a.reference, "--prefilter-fixtures"], check=True, capture_output=True,
                                                 text=True).stdout
             open(os.path.join(bake_dir, "prefilter_fixtures.json"), "w").write(prefilter_fixtures)
+        if a.mode == "room" or a.page == "room":  # the scene, the probes and the expected pixels
+            room_fixtures = subprocess.run([a.reference], check=True, capture_output=True, text=True).stdout
+            open(os.path.join(bake_dir, "room_fixtures.json"), "w").write(room_fixtures)
         if a.mode == "bc6h":  # the blocks and the library's halves; the page reads the blocks
             bc6h_fixtures = subprocess.run([a.reference], check=True, capture_output=True, text=True).stdout
             open(os.path.join(bake_dir, "bc6h_fixtures.json"), "w").write(bc6h_fixtures)
@@ -708,6 +781,9 @@ def main():
         if a.mode == "screenshot":
             try:
                 url = f"http://127.0.0.1:{server.port}/tools/viewer/index.html?bake=/bake/&glsl=/include/ibl/glsl/{a.query}"
+                if a.page == "room":
+                    url = (f"http://127.0.0.1:{server.port}/tools/viewer/room.html?data=/bake/room_fixtures.json"
+                           f"&glsl=/include/ibl/glsl/{a.query}")
                 # --virtual-time-budget lets the page's fetches and first frame finish before the shot.
                 subprocess.run([a.chromium, "--headless=new", "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
                                 "--no-sandbox", "--disable-gpu-sandbox", "--no-first-run",
@@ -721,6 +797,9 @@ def main():
         try:
             url = (f"http://127.0.0.1:{server.port}/tools/viewer/index.html?test={a.mode}&bake=/bake/"
                    f"&glsl=/include/ibl/glsl/&report=/result")
+            if a.mode == "room":
+                url = (f"http://127.0.0.1:{server.port}/tools/viewer/room.html?test=room&data=/bake/room_fixtures.json"
+                       f"&glsl=/include/ibl/glsl/&report=/result")
             result = run_page(a.chromium, url, os.path.join(work, "profile"), a.timeout, server)
         finally:
             server.close()
@@ -739,6 +818,8 @@ def main():
                 open(os.path.join(a.keep, "browser_rgb.bin"), "wb").write(base64.b64decode(result["rgb"]))
         elif a.mode == "prefilter":
             ok = compare_prefilter(json.loads(prefilter_fixtures), result)
+        elif a.mode == "room":
+            ok = compare_room(json.loads(room_fixtures), result, ROOM_REL, ROOM_ABS)
         elif a.mode == "bc6h":
             ok = compare_bc6h(json.loads(bc6h_fixtures), result)
         else:

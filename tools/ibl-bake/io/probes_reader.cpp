@@ -57,6 +57,63 @@ struct probes_reader {
         return true;
     }
 
+    /// A box: {"min", "max"} (axis-aligned) or {"center", "half_extents", "axes"} (oriented).
+    void box(const json_value& x, const std::string& w, probe_volume_desc& d) const {
+        object(x, w);
+        bool aligned = false, oriented = false;
+        for (std::size_t j = 0; j < x.keys.size(); ++j) {
+            const std::string& k = x.keys[j];
+            if (comment(k, x.values[j], w)) continue;
+            if (k == "min" || k == "max") aligned = true;
+            else if (k == "center" || k == "half_extents" || k == "axes") oriented = true;
+            else fail(w + "." + k, "unknown key (expected min, max, or center, half_extents, axes)");
+        }
+        if (aligned && oriented)
+            fail(w, "both min/max and center/half_extents/axes (two forms of a box: give one)");
+        d.sphere = false;
+        if (!oriented) {
+            d.min = vec3(need(x, "min", w), w + ".min");
+            d.max = vec3(need(x, "max", w), w + ".max");
+            for (int a = 0; a < 3; ++a)
+                if (d.min[std::size_t(a)] > d.max[std::size_t(a)]) fail(w, std::string("min > max along ") + "xyz"[a]);
+            return;
+        }
+        d.oriented = true;
+        d.center = vec3(need(x, "center", w), w + ".center");
+        d.half_extents = vec3(need(x, "half_extents", w), w + ".half_extents");
+        for (std::size_t a = 0; a < 3; ++a)
+            if (!(d.half_extents[a] >= 0.0)) fail(w + ".half_extents[" + std::to_string(a) + "]", "must be >= 0");
+        const json_value* ax = x.find("axes");
+        if (!ax) return; // the world's axes
+        const std::string wa = w + ".axes";
+        if (!ax->is_array()) fail(wa, std::string("expected [[x, y, z], [x, y, z], [x, y, z]], got ") + type_name(*ax));
+        if (ax->values.size() != 3) fail(wa, "expected 3 axes, got " + std::to_string(ax->values.size()));
+        using a3 = std::array<double, 3>;
+        const auto dot = [](const a3& a, const a3& b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; };
+        for (std::size_t i = 0; i < 3; ++i) {
+            d.axes[i] = vec3(ax->values[i], wa + "[" + std::to_string(i) + "]");
+            const double len = std::sqrt(dot(d.axes[i], d.axes[i]));
+            if (!(std::fabs(len - 1.0) <= 1e-3))
+                fail(wa + "[" + std::to_string(i) + "]", "not a unit vector (length " + std::to_string(len) + ")");
+        }
+        for (std::size_t i = 0; i < 3; ++i)
+            for (std::size_t j = i + 1; j < 3; ++j)
+                if (!(std::fabs(dot(d.axes[i], d.axes[j])) <= 1e-3))
+                    fail(wa, "axes[" + std::to_string(i) + "] and axes[" + std::to_string(j) +
+                                 "] are not perpendicular (dot " + std::to_string(dot(d.axes[i], d.axes[j])) + ")");
+        // Gram-Schmidt: exactly orthonormal (the checks above keep every step well away from zero)
+        for (std::size_t i = 0; i < 3; ++i) {
+            a3 v = d.axes[i];
+            for (std::size_t j = 0; j < i; ++j) {
+                const double p = dot(v, d.axes[j]);
+                for (std::size_t c = 0; c < 3; ++c) v[c] -= p * d.axes[j][c];
+            }
+            const double len = std::sqrt(dot(v, v));
+            for (std::size_t c = 0; c < 3; ++c) v[c] /= len;
+            d.axes[i] = v;
+        }
+    }
+
     /// {"box": {...}} or {"sphere": {...}} (and, for influences, "fade").
     probe_volume_desc volume(const json_value& v, const std::string& where, double* fade) const {
         object(v, where);
@@ -69,16 +126,7 @@ struct probes_reader {
             const std::string w = where + "." + k;
             if (comment(k, x, where)) continue;
             if (k == "box") {
-                object(x, w);
-                for (std::size_t j = 0; j < x.keys.size(); ++j)
-                    if (x.keys[j] != "min" && x.keys[j] != "max" && !comment(x.keys[j], x.values[j], w))
-                        fail(w + "." + x.keys[j], "unknown key (expected min, max)");
-                d.sphere = false;
-                d.min = vec3(need(x, "min", w), w + ".min");
-                d.max = vec3(need(x, "max", w), w + ".max");
-                for (int a = 0; a < 3; ++a)
-                    if (d.min[std::size_t(a)] > d.max[std::size_t(a)])
-                        fail(w, std::string("min > max along ") + "xyz"[a]);
+                box(x, w, d);
                 ++shapes;
             } else if (k == "sphere") {
                 object(x, w);

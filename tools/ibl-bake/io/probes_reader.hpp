@@ -6,12 +6,17 @@
 //   {"probes": [{"input": "a.exr",                       capture (any --input form), relative
 //                                                        paths against the JSON file's folder
 //                "position": [x, y, z],                  capture point C
-//                "proxy": {"box": {"min": [..], "max": [..]}}   or {"sphere": {"center": [..], "radius": r}}
+//                "proxy": {"box": {"min": [..], "max": [..]}}   axis-aligned, or
+//                         {"box": {"center": [..], "half_extents": [..], "axes": [[..], [..], [..]]}}
+//                                                        oriented (axes optional: the world's), or
+//                         {"sphere": {"center": [..], "radius": r}}
 //                "influence": {"box": ... | "sphere": ..., "fade": f},   fade width f > 0
 //                "priority": 0},                         optional integer (default 0), higher first
 //               ...]}
-// Rules: 1..probe_set_max probes; every number finite; box min <= max per axis; radius > 0;
-// fade > 0; unknown keys are errors ("$comment" and "description" strings are allowed at every
+// Rules: 1..probe_set_max probes; every number finite; box min <= max per axis; one box form
+// (min/max or center/half_extents/axes); half_extents >= 0; axes three unit vectors (length within
+// 1e-3 of 1), pairwise perpendicular (|dot| <= 1e-3), stored orthonormalised (Gram-Schmidt in
+// their order); radius > 0; fade > 0; unknown keys are errors ("$comment" and "description" strings are allowed at every
 // level). Any text gives a probe set or throws probes_error (never anything else).
 
 #include <array>
@@ -30,12 +35,15 @@ public:
 
 inline constexpr std::size_t probe_set_max = 64;
 
-/// A box (axis-aligned: min, max) or a sphere (center, radius).
+/// A box (axis-aligned: min, max; or oriented: center, half_extents, axes) or a sphere (center, radius).
 struct probe_volume_desc {
     bool sphere = false;
-    std::array<double, 3> min{}, max{};   ///< box
-    std::array<double, 3> center{};       ///< sphere
+    bool oriented = false;                ///< a box given as center, half_extents, axes
+    std::array<double, 3> min{}, max{};   ///< axis-aligned box
+    std::array<double, 3> center{};       ///< sphere; oriented box
     double radius = 0.0;                  ///< sphere
+    std::array<double, 3> half_extents{}; ///< oriented box: >= 0 along each axis
+    std::array<std::array<double, 3>, 3> axes{{{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}}}; ///< oriented box: orthonormal
 };
 
 struct probe_desc {

@@ -271,8 +271,22 @@ const option_map& option_table() {
     return t;
 }
 
+/// The options a probe-set bake (--probes) uses besides --probes and --out: each capture is read
+/// like --input (--input-layout, --max-input-pixels, --part), baked into the full bake's chain
+/// (--size, --levels, --quality, --threads, --policy, --ld-weight, --prefilter, --mirror) and SH3,
+/// and stored in one KTX2 array (--ktx2-format, --ktx2-quality, --ktx2-zstd); --quiet.
+bool applies_to_probes(const std::string& name) {
+    static const char* const used[] = {"--probes", "--out", "--input-layout", "--max-input-pixels", "--part", "--size",
+                                       "--levels", "--quality", "--threads", "--policy", "--ld-weight", "--prefilter",
+                                       "--mirror", "--ktx2-format", "--ktx2-quality", "--ktx2-zstd", "--quiet",
+                                       "--help", "-h", "--version"};
+    for (const char* u : used)
+        if (name == u) return true;
+    return false;
+}
+
 /// Checks that need every option: required ones, combinations, --levels against --size.
-void check_combination(const bake_options& o, bool have_out) {
+void check_combination(const bake_options& o, bool have_out, const std::vector<std::string>& given) {
     if (!o.lookup.empty()) {
         if (have_out || !o.input.empty() || !o.scene.empty() || !o.probes.empty())
             throw usage_error("--lookup DIR answers queries about an existing bake: no --out, --input, --scene or --probes");
@@ -281,6 +295,13 @@ void check_combination(const bake_options& o, bool have_out) {
     if (!have_out) throw usage_error("--out DIR is required");
     if (!o.probes.empty() && (!o.input.empty() || !o.scene.empty()))
         throw usage_error("--probes takes each probe's input from its file: no --input or --scene");
+    if (!o.probes.empty())
+        for (const std::string& name : given)
+            if (!applies_to_probes(name))
+                throw usage_error(name + " does not apply to --probes (a probe set bakes each capture's specular chain and "
+                                         "SH3 only; it takes --size, --levels, --quality, --threads, --policy, --ld-weight, "
+                                         "--prefilter, --mirror, --input-layout, --max-input-pixels, --part, --ktx2-format, "
+                                         "--ktx2-quality, --ktx2-zstd, --quiet)");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.strict && o.scene.empty()) throw usage_error("--strict needs --scene");
     if (o.levels > 0) {
@@ -297,6 +318,7 @@ void check_combination(const bake_options& o, bool have_out) {
 bake_options parse_options(const std::vector<std::string>& args) {
     bake_options o;
     bool have_out = false;
+    std::vector<std::string> given; // the options named, in order (a probe-set bake refuses the others)
     for (std::size_t i = 0; i < args.size(); ++i) {
         std::string name = args[i], value;
         bool inline_value = false;
@@ -316,9 +338,10 @@ bake_options parse_options(const std::vector<std::string>& args) {
         }
         it->second.apply(o, value);
         have_out = have_out || name == "--out";
+        given.push_back(name);
     }
     if (o.help || o.version) return o;
-    check_combination(o, have_out);
+    check_combination(o, have_out, given);
     return o;
 }
 

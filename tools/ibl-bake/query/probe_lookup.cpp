@@ -17,6 +17,7 @@
 #include "io/image_io.hpp"
 #include "io/json_value.hpp"
 #include "io/ktx2.hpp"
+#include "stages/probe_bake.hpp"
 
 namespace ibl_bake {
 
@@ -46,8 +47,20 @@ struct probe_json {
     /// A volume: sets box or sphere, returns whether it is a sphere.
     bool volume(const json_value& v, const std::string& where, ibl::probe_box<double>& box, ibl::probe_sphere<double>& ball) const {
         if (const json_value* b = v.find("box")) {
-            box = ibl::probe_box<double>::axis_aligned(vec(need(*b, "min", where + ".box"), where + ".box.min"),
-                                                       vec(need(*b, "max", where + ".box"), where + ".box.max"));
+            const std::string w = where + ".box";
+            if (b->find("min")) {
+                box = ibl::probe_box<double>::axis_aligned(vec(need(*b, "min", w), w + ".min"), vec(need(*b, "max", w), w + ".max"));
+                return false;
+            }
+            // oriented: center, half_extents, axes (orthonormal as the bake wrote them)
+            box.center = vec(need(*b, "center", w), w + ".center");
+            box.half = vec(need(*b, "half_extents", w), w + ".half_extents");
+            const json_value& axes = need(*b, "axes", w);
+            if (!axes.is_array() || axes.values.size() != 3) fail(w + ".axes", "expected 3 axes");
+            for (std::size_t i = 0; i < 3; ++i) {
+                box.axis[i] = vec(axes.values[i], w + ".axes");
+                if (!(std::fabs(glm::length(box.axis[i]) - 1.0) <= 1e-6)) fail(w + ".axes", "not unit vectors");
+            }
             return false;
         }
         const json_value& s = need(v, "sphere", where);
@@ -66,7 +79,18 @@ using query_text::unit;
 
 bool is_probe_set_folder(const std::string& dir) {
     std::error_code ec;
-    return std::filesystem::is_regular_file(dir + "/probes.json", ec) && !std::filesystem::exists(dir + "/report.json", ec);
+    if (!std::filesystem::is_regular_file(dir + "/probes.json", ec)) return false;
+    if (!std::filesystem::exists(dir + "/report.json", ec)) return true; // a probe set baked before it wrote a report
+    // both files: the report says which bake wrote the folder last (a folder keeps the files a
+    // bake does not write, so a single bake over a probe set leaves probes.json behind)
+    try {
+        const std::vector<unsigned char> text = read_file(dir + "/report.json");
+        const json_value r = ibl_examples::parse_json(std::string(text.begin(), text.end()));
+        const json_value* f = r.is_object() ? r.find("format") : nullptr;
+        return f && f->is_string() && f->string == probe_report_format;
+    } catch (const std::exception&) {
+        return false; // an unreadable report: the single bake's loader says what is wrong with it
+    }
 }
 
 probe_set_folder load_probe_set(const std::string& dir) {

@@ -46,7 +46,8 @@ struct probe_set_folder {
     ibl::specular_lookup_desc specular = ibl::specular_lookup_desc::textbook();
 };
 
-/// True when DIR holds probes.json (a --probes output) and no report.json.
+/// True when DIR holds probes.json (a --probes output) and either no report.json or a probe-set report
+/// (its "format" is probe_report_format, stages/probe_bake.hpp).
 bool is_probe_set_folder(const std::string& dir);
 
 /// Loads DIR's probes.json and probes.ktx2. Throws image_error / std::runtime_error naming the file.

@@ -11,6 +11,10 @@
 //                 conventions, and per probe its layer, position, proxy, influence, fade,
 //                 priority and SH3 (radiance and irradiance E coefficients of ibl/sh/basis.hpp's
 //                 real basis, raw: no window)
+//   report.json   per probe: its input and size, bake and check times, each level against its
+//                 reference (the full bake's specular check with --checks fast's grid and samples:
+//                 rel_rmse, nrmse, max_overshoot, max_rel) and the storage's rounding
+//                 (ktx2_quantisation); "format" is probe_report_format
 // and a short report on stdout. --lookup DIR answers `local` and `local_irradiance` queries on
 // such a folder (query/probe_lookup.hpp).
 
@@ -19,6 +23,9 @@
 #include "options/bake_options.hpp"
 
 namespace ibl_bake {
+
+/// report.json's "format" in a probe-set folder (what tells --lookup a probe set from a single bake).
+inline constexpr const char* probe_report_format = "ibl-bake probe-set report";
 
 /// Throws probes_error (a bad probe-set file), image_error (an unreadable input) or
 /// std::runtime_error (the output); DIR is then left as it was.

@@ -212,6 +212,76 @@ TEST_CASE("probes: bake writes a cubemap array and its metadata") {
     for (int c = 0; c < 3; ++c) CHECK(e[c] == doctest::Approx(ibl::pi_v<double> * constant_b[c]).epsilon(1e-3));
 }
 
+TEST_CASE("probes: report.json per probe") {
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    CHECK(b.stdout_text.find("report.json") != std::string::npos);
+    const ibl_examples::json_value r = ibl_examples::parse_json(slurp(b.out + "/report.json"));
+    REQUIRE(r.find("format"));
+    CHECK(r.find("format")->string == "ibl-bake probe-set report");
+    CHECK(r.find("settings")->find("face_size")->number == 16);
+    CHECK(r.find("settings")->find("quality")->string == "low");
+    CHECK(r.find("time_ms")->number > 0.0);
+    CHECK(r.find("ktx2")->find("bytes")->number == double(read_file(b.out + "/probes.ktx2").size()));
+    const ibl_examples::json_value j = ibl_examples::parse_json(slurp(b.out + "/probes.json"));
+    const std::size_t levels = std::size_t(j.find("levels")->number);
+    const auto& probes = r.find("probes")->values;
+    REQUIRE(probes.size() == 2);
+    for (std::size_t i = 0; i < 2; ++i) {
+        const ibl_examples::json_value& p = probes[i];
+        CAPTURE(i);
+        CHECK(p.find("layer")->number == double(i));
+        CHECK(p.find("input")->string.find(i == 0 ? "a.exr" : "b.hdr") != std::string::npos);
+        CHECK(p.find("input_size")->values.at(0).number == 32);
+        CHECK(p.find("input_size")->values.at(1).number == 16);
+        CHECK(p.find("time_ms")->number > 0.0);
+        const auto& lv = p.find("levels")->values;
+        REQUIRE(lv.size() == levels);
+        for (std::size_t k = 0; k < levels; ++k) {
+            CAPTURE(k);
+            CHECK(lv[k].find("size")->number == double(16 >> k));
+            CHECK(lv[k].find("roughness")->number ==
+                  doctest::Approx(j.find("conventions")->find("level_roughness")->values.at(k).number));
+            CHECK(lv[k].find("texels_compared")->number > 0);
+            const double e = lv[k].find("rel_rmse")->number;
+            CHECK(e >= 0.0);
+            // the constant capture is filtered exactly (half-float storage aside); the pattern's
+            // low-quality chain stays within 10% of its reference
+            CHECK(e < (i == 1 ? 1e-3 : 0.1));
+        }
+        REQUIRE(p.find("ktx2_quantisation"));
+    }
+    // --lookup still takes the folder as a probe set (its report says so)
+    int st = 0;
+    const auto lines = b.lookup("local -2 0 0 0 1 0 0.5\n", &st);
+    CHECK(st == 0);
+    REQUIRE(lines.size() == 1);
+    CHECK(lines[0].find("error") == std::string::npos);
+}
+
+TEST_CASE("probes: --lookup tells the bake that wrote a folder last by its report.json") {
+    // A folder keeps the files a bake does not write: a single bake over a probe set leaves
+    // probes.json behind, a probe set over a single bake leaves specular.ktx2; report.json's
+    // "format" says which bake wrote the folder last.
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    const std::string dir = b.s / "mixed";
+    std::filesystem::remove_all(dir);
+    std::filesystem::copy(b.out, dir, std::filesystem::copy_options::recursive);
+    const auto ask = [&](const std::string& q) {
+        std::ofstream(b.s / "mq.txt") << q;
+        shell(tool + " --lookup " + dir + " <" + b.s / "mq.txt" + " >" + b.s / "ma.txt" + " 2>&1");
+        return slurp(b.s / "ma.txt");
+    };
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == std::string::npos);
+    REQUIRE(shell(tool + " --size 16 --quality low --checks none --threads 2 --quiet --out " + dir + " >/dev/null 2>&1") == 0);
+    CHECK(std::filesystem::exists(dir + "/probes.json")); // kept
+    CHECK(ask("specular 0 0 1 0.5\n").find("error") == std::string::npos);
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == 0); // a single bake now: no local queries
+    REQUIRE(shell(tool + " --probes " + b.s / "probes.json" + " --size 16 --quality low --threads 2 --out " + dir + " >/dev/null 2>&1") == 0);
+    CHECK(ask("local 0 0 0 0 1 0 0.5\n").find("error") == std::string::npos);
+}
+
 TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
@@ -262,6 +332,82 @@ TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     CHECK(e(0, dvec3(0, 1, 0)).x > e(0, dvec3(0, -1, 0)).x);
 }
 
+TEST_CASE("probes: oriented boxes (center, half_extents, axes)") {
+    // One probe, the proxy a box turned 30 degrees about y (axes slightly off unit length and
+    // perpendicularity: the reader orthonormalises them), the influence an oriented box with the
+    // world's axes. probes.json carries the oriented form; `local` answers with the oriented proxy.
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    std::ofstream(b.s / "oriented.json") << R"({"probes": [
+  {"input": "a.exr", "position": [0.5, 0, 0],
+   "proxy": {"box": {"center": [0, 0, 0], "half_extents": [4, 2, 3],
+                     "axes": [[0.86603, 0, -0.5], [0, 1, 0], [0.5, 0, 0.86602]]}},
+   "influence": {"box": {"center": [0, 0, 0], "half_extents": [5, 3, 4]}, "fade": 1}}]})";
+    const std::string out = b.s / "oriented_set";
+    REQUIRE(shell(tool + " --probes " + b.s / "oriented.json" + " --out " + out + " --size 16 --quality low --threads 2 >/dev/null 2>" +
+                  b.s / "oriented_err.txt") == 0);
+    const ibl_examples::json_value j = ibl_examples::parse_json(slurp(out + "/probes.json"));
+    const ibl_examples::json_value& pr = j.find("probes")->values.at(0);
+    const ibl_examples::json_value* box = pr.find("proxy")->find("box");
+    REQUIRE(box);
+    CHECK(!box->find("min"));
+    REQUIRE(box->find("axes"));
+    const double c30 = std::sqrt(3.0) / 2.0;
+    const dvec3 ax0(box->find("axes")->values.at(0).values.at(0).number, box->find("axes")->values.at(0).values.at(1).number,
+                    box->find("axes")->values.at(0).values.at(2).number);
+    CHECK(glm::length(ax0) == doctest::Approx(1.0).epsilon(1e-12));
+    CHECK(ax0.x == doctest::Approx(c30).epsilon(1e-5));
+    CHECK(box->find("half_extents")->values.at(2).number == 3);
+    REQUIRE(pr.find("influence")->find("box")->find("axes"));
+    CHECK(pr.find("influence")->find("box")->find("axes")->values.at(1).values.at(1).number == 1.0);
+
+    ibl::probe_box<double> proxy;
+    proxy.center = dvec3(0.0);
+    proxy.half = dvec3(4, 2, 3);
+    proxy.axis[0] = dvec3(c30, 0, -0.5);
+    proxy.axis[1] = dvec3(0, 1, 0);
+    proxy.axis[2] = dvec3(0.5, 0, c30);
+    const ibl::probe_box<double> aligned = ibl::probe_box<double>::axis_aligned(dvec3(-4, -2, -3), dvec3(4, 2, 3));
+    const std::vector<ibl::cubemap<float>> layers = decoded_layers(out);
+    REQUIRE(layers.size() == 1);
+    const ibl::specular_lookup_desc desc = ibl::specular_lookup_desc::textbook();
+    const dvec3 p(-1.5, 0.5, 1.0), c(0.5, 0, 0), d = glm::normalize(dvec3(-0.8, 0.1, 0.3));
+    const double r = 0.2;
+    const auto corrected = [&](const ibl::probe_box<double>& bx) {
+        const auto l = ibl::parallax_correct(bx, c, p, d);
+        REQUIRE(l.hit);
+        return dvec3(ibl::specular_lookup(layers[0], fvec3(l.direction), float(ibl::corrected_roughness(r, l.d_shading, l.d_probe)), desc));
+    };
+    std::ofstream(b.s / "oq.txt") << "local -1.5 0.5 1 -0.8 0.1 0.3 0.2\n";
+    REQUIRE(shell(tool + " --lookup " + out + " <" + b.s / "oq.txt" + " >" + b.s / "oa.txt" + " 2>&1") == 0);
+    const dvec3 got = parse3(slurp(b.s / "oa.txt"));
+    check_close(got, corrected(proxy), 1e-5, "oriented proxy");
+    // the orientation matters here: the axis-aligned box of the same extents gives another answer
+    const dvec3 other = corrected(aligned);
+    CHECK(std::fabs(other.x - got.x) + std::fabs(other.y - got.y) > 1e-3);
+}
+
+TEST_CASE("probes: options that do not apply to a probe set are refused") {
+    const baked_set& b = the_set();
+    REQUIRE(b.status == 0);
+    const std::string base = tool + " --probes " + b.s / "probes.json" + " --out " + b.s / "refused_out" + " --size 16 --quality low ";
+    for (const std::string opt : {"--sheen", "--runtime taps2", "--runtime=lobe", "--preset filament", "--specular-lookup accurate",
+                                  "--extract-sun on", "--irradiance-size 8", "--dfg-layout uniform", "--sh-bands 3",
+                                  "--sh-window none", "--lut-size 16", "--layout faces", "--checks full", "--verbose",
+                                  "--compare-full", "--strict"}) {
+        const std::string name = opt.substr(0, opt.find_first_of(" ="));
+        CHECK_MESSAGE(shell(base + opt + " 2>" + b.s / "refused.txt" + " >/dev/null") == 2, opt);
+        const std::string err = slurp(b.s / "refused.txt");
+        CHECK_MESSAGE(err.find(name + " does not apply to --probes") != std::string::npos, err);
+        CHECK(!std::filesystem::exists(b.s / "refused_out"));
+    }
+    // the options a probe set uses are accepted (a usage error would be exit status 2)
+    CHECK(shell(base + "--levels 3 --threads 2 --policy filament --ld-weight g1 --prefilter fast --mirror --input-layout auto "
+                       "--max-input-pixels 100000 --ktx2-format rgba32f --ktx2-zstd 0 --ktx2-quality fast --quiet >/dev/null 2>" +
+                b.s / "accepted.txt") == 0);
+    CHECK(std::filesystem::exists(b.s / "refused_out" + "/probes.ktx2"));
+}
+
 TEST_CASE("probes: lookup errors on a probe set") {
     const baked_set& b = the_set();
     REQUIRE(b.status == 0);
@@ -298,6 +444,19 @@ TEST_CASE("probes: malformed probe files name the probe and the key") {
         {one(good + box + R"(, "influence": {"sphere": {"center": [0, 0, 0], "radius": 1}})"), "probes[1].influence: missing \"fade\""},
         {one(good + box + ", " + infl + R"(, "priority": 0.5)"), "probes[1].priority: expected an integer"},
         {one(good + box + ", " + infl + R"(, "colour": 1)"), "probes[1].colour: unknown key"},
+        {one(good + R"("proxy": {"box": {"min": [0, 0, 0], "center": [1, 1, 1], "half_extents": [1, 1, 1]}}, )" + infl),
+         "probes[1].proxy.box: both min/max and center/half_extents/axes"},
+        {one(good + R"("proxy": {"box": {"center": [1, 1, 1]}}, )" + infl), "probes[1].proxy.box: missing \"half_extents\""},
+        {one(good + R"("proxy": {"box": {"center": [1, 1, 1], "half_extents": [1, -1, 1]}}, )" + infl),
+         "probes[1].proxy.box.half_extents[1]: must be >= 0"},
+        {one(good + box + R"(, "influence": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0, 2, 0], [0, 0, 1]]}, "fade": 1})"),
+         "probes[1].influence.box.axes[1]: not a unit vector"},
+        {one(good + box + R"(, "influence": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0.6, 0.8, 0], [0, 0, 1]]}, "fade": 1})"),
+         "probes[1].influence.box.axes: axes[0] and axes[1] are not perpendicular"},
+        {one(good + R"("proxy": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "axes": [[1, 0, 0], [0, 1, 0]]}}, )" + infl),
+         "probes[1].proxy.box.axes: expected 3 axes"},
+        {one(good + R"("proxy": {"box": {"center": [0, 0, 0], "half_extents": [1, 1, 1], "rotation": 30}}, )" + infl),
+         "probes[1].proxy.box.rotation: unknown key"},
         {R"({"probes": []})", "probes: no probes"},
         {many, "65 probes, at most 64"},
         {R"([1, 2])", "expected an object"},
