@@ -426,7 +426,7 @@ public:
     [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
         if (peaks_.empty()) return {};
         return make_peak_level(peaks_, n0_, table_source_levels_, lp.roughness, opt_.weight, opt_.peaks.footprint,
-                               opt_.peaks.max_merge_angle, mean_);
+                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut);
     }
     /// Row `row` (face n + y) of an n x n level.
     void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out) const {

@@ -79,6 +79,10 @@ struct peak_split_options {
     /// horizon, where n.l cuts them off).
     double footprint = 6.0;
     double max_merge_angle = 1.0 / 16.0;
+    /// Per face row, peaks whose summed largest contributions stay below cut times the row's
+    /// darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
+    /// peak that is in front of some texel of the row (the GPU filter's sum).
+    double cut = 1e-3;
 };
 
 /// One peak: its direction (unit) and its energy (Omega times the radiance above the threshold).
@@ -243,6 +247,7 @@ struct peak_level {
     std::vector<float> lum; ///< luminance of (er, eg, eb): the row cut's bound
     float a2 = 0.f, half_a2 = 0.f;
     float floor = 0.f; ///< the cut's floor: 1e-2 times the source's mean luminance
+    float cut = 0.f;   ///< peak_split_options::cut
     bool g1 = false;
     [[nodiscard]] std::size_t size() const noexcept { return px.size(); }
 };
@@ -250,7 +255,8 @@ struct peak_level {
 /// Builds a level's peak list: the split's peaks merged at peak_merge_mip, with the kernel of the
 /// GGX lobe at roughness r and the LD weight.
 inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
-                                  ld_weight weight, double footprint, double max_angle, double mean_luminance) {
+                                  ld_weight weight, double footprint, double max_angle, double mean_luminance,
+                                  double cut = 1e-3) {
     peak_level pl;
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
@@ -266,6 +272,7 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
         pl.lum.push_back(float(luminance(p.energy) * scale));
     }
     pl.floor = float(1e-2 * mean_luminance);
+    pl.cut = std::isfinite(cut) && cut > 0.0 ? float(cut) : 0.f;
     pl.a2 = float(a2);
     pl.half_a2 = float(0.5 * a2);
     pl.g1 = weight == ld_weight::g1;
@@ -280,9 +287,9 @@ inline constexpr int peak_lanes = 16;
 /// Adds the peaks of a level to row y of face `face` of its n x n output: out[x] += sum_j
 /// E_j K(R_x . d_j) / integral K (header comment), the peaks in list order. Per row, a peak is
 /// skipped when it lies beyond the hemisphere of every texel of the row, or when its largest
-/// contribution to the row times the number of peaks is below 1e-3 of the row's darkest tap-set
-/// result (at least 1e-2 of the source's mean luminance): the skipped peaks together change no
-/// texel of the row by more than 1e-3 relative.
+/// contribution to the row times the number of peaks is below `cut` (1e-3 by default) of the
+/// row's darkest tap-set result (at least 1e-2 of the source's mean luminance): the skipped peaks
+/// together change no texel of the row by more than `cut` relative.
 inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<float>* out) {
     if (pl.size() == 0) return;
     // The row's bounding cone: its middle texel's direction and the larger angle to its ends.
@@ -294,7 +301,7 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
     const float ha2 = pl.half_a2, a2 = pl.a2, one_minus_a2 = 1.f - pl.a2;
     float darkest = luminance(out[0]);
     for (int x = 1; x < n; ++x) darkest = std::min(darkest, luminance(out[x]));
-    const float cut = 1e-3f * std::max(darkest, pl.floor) / float(pl.size());
+    const float cut = pl.cut * std::max(darkest, pl.floor) / float(pl.size());
     std::vector<std::uint32_t> live;
     live.reserve(pl.size());
     for (std::size_t j = 0; j < pl.size(); ++j) {
@@ -304,7 +311,7 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
         const float c_max = ca >= cos_half ? 1.f : ca * cos_half + std::sqrt(std::max(0.f, 1.f - ca * ca)) * sin_half;
         if (!(c_max > 0.f)) continue;
         const float qb = 0.5f * (1.f - c_max) + ha2 * (1.f + c_max);
-        if (pl.lum[j] / (qb * qb) < cut) continue; // w(c) <= 1 for both weights
+        if (cut > 0.f && pl.lum[j] / (qb * qb) < cut) continue; // w(c) <= 1 for both weights
         live.push_back(std::uint32_t(j));
     }
     if (live.empty()) return;
