@@ -420,8 +420,10 @@ std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method) 
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
-                               prefilter_choice method) {
+                               prefilter_choice method, std::uint32_t fast_peaks) {
     ibl::prefilter_options o;
+    o.peaks.enabled = fast_peaks > 0;
+    o.peaks.max_peaks = fast_peaks;
     o.base_size = sp.virtual_base_size;
     o.policy = sp.policy;
     o.weight = w;

@@ -86,8 +86,14 @@ public:
         ctx.prog.begin("prefilter");
         weight_ = ctx.opt.ld_weight;
         method_ = ctx.opt.prefilter;
-        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_);
+        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_, ctx.opt.fast_peaks);
         ms_ = ctx.prog.end();
+        if (method_ == prefilter_choice::fast && ctx.opt.fast_peaks > 0) { // the split again, for the report (untimed)
+            ibl::peak_split_options po;
+            po.max_peaks = ctx.opt.fast_peaks;
+            const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(ctx.source, po, ctx.ex);
+            peaks_ = {true, po.ratio, po.max_peaks, split.peaks.size(), split.threshold, split.mean_luminance};
+        }
         chain_ = &*ctx.chain;
         sp_ = ctx.plan.specular;
         analytic_ = ctx.src.analytic;
@@ -147,6 +153,13 @@ private:
     quality_settings qs_{};
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     prefilter_choice method_ = prefilter_choice::fis;
+    struct peak_report {
+        bool on = false;
+        double ratio = 0.0;
+        std::uint32_t max_peaks = 0;
+        std::size_t count = 0;
+        double threshold = 0.0, mean = 0.0;
+    } peaks_;
     double ms_ = 0.0, check_ms_ = 0.0, floor_ = 0.0;
     bool checked_ = true;
     std::vector<level_check> checks_;
@@ -280,8 +293,10 @@ void specular_stage::report(json_writer& j) const {
     else j.null();
     j.key("prefilter").value(to_string(method_));
     j.key("method").value(std::string(method_ == prefilter_choice::fast
-                                          ? "GGX fast filter (ibl::prefilter_method::fast: polar tap sets shaped offline, "
-                                            "read from the exact-solid-angle mips), "
+                                          ? std::string("GGX fast filter (ibl::prefilter_method::fast: spiral tap sets shaped offline, "
+                                                        "read from the exact-solid-angle mips") +
+                                                (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel), "
+                                                           : "), ")
                                           : "GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
@@ -293,6 +308,13 @@ void specular_stage::report(json_writer& j) const {
     if (method_ == prefilter_choice::fast) j.key("lod_bias").value("per level: the fast table's shape (ibl::fast_shape)");
     else j.key("lod_bias").value(0.5);
     j.end_object();
+    if (method_ == prefilter_choice::fast) {
+        j.key("peaks").begin_object().key("enabled").value(peaks_.on);
+        if (peaks_.on)
+            j.key("ratio").value(peaks_.ratio).key("max_peaks").value(peaks_.max_peaks).key("count").value(std::uint64_t(peaks_.count))
+                .key("threshold").value(peaks_.threshold).key("mean_luminance").value(peaks_.mean);
+        j.end_object();
+    }
     j.key("time_ms").value(ms_);
     j.key("mip_policy").value(sp_.policy.mapping == ibl::roughness_mapping::filament
                                   ? "filament: roughness r at virtual lod v = (V - 1) r (2 - r) of V levels; stored level = v - first_level"

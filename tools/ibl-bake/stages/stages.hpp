@@ -215,8 +215,9 @@ inline constexpr std::uint32_t fast_samples_divisor = 16;
 /// The samples a level of the chain is filtered with: the plan's for fis, the fast filter's for fast.
 std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method);
 /// The plan's chain filtered by `method` (ibl::prefilter with a level plan).
+/// fast_peaks: the fast filter's peak split (ibl::peak_split_options::max_peaks; 0 = off).
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
-                               prefilter_choice method = prefilter_choice::fis);
+                               prefilter_choice method = prefilter_choice::fis, std::uint32_t fast_peaks = 1024);
 
 /// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
