@@ -13,10 +13,12 @@ Real = Union[float, np.ndarray]
 
 __version__: str
 builtin_models: tuple[str, ...]
+model_batch_nodes: int  # the most nodes a Python model's methods see in one call (2^16)
 
 class BRDFModel(Protocol):
     """A Python BRDF model (brdf/model.hpp's contract). Every method receives float64 arrays of
-    equal shape (one batch of quadrature nodes) and returns an array of that shape (or a scalar).
+    equal shape (one batch of quadrature nodes, at most model_batch_nodes long) and returns an
+    array of that shape (or a scalar).
     Either ndf + visibility (the weight 4 V n.l (v.h) / n.h * D / D_ggx is formed by the binding) or
     sample_weight must be present."""
     def alpha(self, roughness: np.ndarray) -> np.ndarray: ...
