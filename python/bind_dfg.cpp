@@ -278,6 +278,60 @@ model_arg parse_model(const char* fn, py::object model) {
 
 // ---- ibl.dfg ---------------------------------------------------------------------------------------
 
+/// E = A + B and B of n points for a Python model: the default rule of dfg_exact, the kernel run
+/// as the file header describes, per batch of whole points. Output: eb[2 i] = E, eb[2 i + 1] = B.
+std::vector<double> python_dfg_eb(const py::object& obj, const double* mu, const double* r, std::size_t n) {
+    std::vector<double> eb(2 * n);
+    const python_model pm(obj);
+    const ibl::dfg_quadrature_rule& rule = ibl::default_dfg_quadrature_rule();
+    const ibl::dfg_quadrature_view q = rule.view();
+    const std::size_t evals = rule.nodes().evaluations();
+    const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
+    batch_nodes nodes(std::min(n, per_batch) * evals);
+    for (std::size_t begin = 0; begin < n; begin += per_batch) {
+        const std::size_t end = std::min(n, begin + per_batch), m = end - begin;
+        const std::vector<double> alpha = pm.alpha(std::vector<double>(r + begin, r + end));
+        nodes.use(m * evals);
+        node_buffer buf{};
+        {
+            py::gil_scoped_release release;
+            tls_guard g(&buf);
+            buf.nv = nodes.data[0];
+            buf.nl = nodes.data[1];
+            buf.nh = nodes.data[2];
+            buf.vh = nodes.data[3];
+            buf.capacity = nodes.n;
+            double* pr = nodes.data[4];
+            double* pa = nodes.data[5];
+            for (std::size_t i = 0; i < m; ++i) {
+                buf.alpha = alpha[i];
+                double e, bb;
+                ibl::dfg_quadrature_lanes<recording_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
+                std::fill(pr + i * evals, pr + (i + 1) * evals, r[begin + i]);
+                std::fill(pa + i * evals, pa + (i + 1) * evals, alpha[i]);
+            }
+        }
+        if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg: the quadrature's node count changed");
+        const python_model::values vals = pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
+        py::gil_scoped_release release;
+        node_buffer rep{};
+        tls_guard g(&rep);
+        rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
+        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
+        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
+        rep.capacity = nodes.n;
+        for (std::size_t i = 0; i < m; ++i) {
+            rep.alpha = alpha[i];
+            double e, bb;
+            ibl::dfg_quadrature_lanes<replay_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
+            eb[2 * (begin + i)] = e;
+            eb[2 * (begin + i) + 1] = bb;
+        }
+    }
+    return eb;
+}
+
+
 py::object dfg(py::object n_dot_v, py::object roughness, py::object model, unsigned threads) {
     const model_arg ma = parse_model("dfg", model);
     const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
@@ -299,51 +353,10 @@ py::object dfg(py::object n_dot_v, py::object roughness, py::object model, unsig
             });
         });
     } else {
-        const python_model pm(ma.obj);
-        const ibl::dfg_quadrature_rule& rule = ibl::default_dfg_quadrature_rule();
-        const ibl::dfg_quadrature_view q = rule.view();
-        const std::size_t evals = rule.nodes().evaluations();
-        const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
-        batch_nodes nodes(std::min(n, per_batch) * evals);
-        for (std::size_t begin = 0; begin < n; begin += per_batch) {
-            const std::size_t end = std::min(n, begin + per_batch), m = end - begin;
-            const std::vector<double> alpha = pm.alpha(std::vector<double>(r + begin, r + end));
-            nodes.use(m * evals);
-            node_buffer buf{};
-            {
-                py::gil_scoped_release release;
-                tls_guard g(&buf);
-                buf.nv = nodes.data[0];
-                buf.nl = nodes.data[1];
-                buf.nh = nodes.data[2];
-                buf.vh = nodes.data[3];
-                buf.capacity = nodes.n;
-                double* pr = nodes.data[4];
-                double* pa = nodes.data[5];
-                for (std::size_t i = 0; i < m; ++i) {
-                    buf.alpha = alpha[i];
-                    double e, bb;
-                    ibl::dfg_quadrature_lanes<recording_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
-                    std::fill(pr + i * evals, pr + (i + 1) * evals, r[begin + i]);
-                    std::fill(pa + i * evals, pa + (i + 1) * evals, alpha[i]);
-                }
-            }
-            if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg: the quadrature's node count changed");
-            const python_model::values vals = pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
-            py::gil_scoped_release release;
-            node_buffer rep{};
-            tls_guard g(&rep);
-            rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
-        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
-        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
-            rep.capacity = nodes.n;
-            for (std::size_t i = 0; i < m; ++i) {
-                rep.alpha = alpha[i];
-                double e, bb;
-                ibl::dfg_quadrature_lanes<replay_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
-                ab[2 * (begin + i)] = e - bb;
-                ab[2 * (begin + i) + 1] = bb;
-            }
+        const std::vector<double> eb = python_dfg_eb(ma.obj, mu, r, n);
+        for (std::size_t i = 0; i < n; ++i) {
+            ab[2 * i] = eb[2 * i] - eb[2 * i + 1];
+            ab[2 * i + 1] = eb[2 * i + 1];
         }
     }
     auto emit = [&](auto tag) {
@@ -474,7 +487,7 @@ builtin builtin_only(const char* fn, py::object model) {
     const model_arg ma = parse_model(fn, model);
     if (!ma.is_builtin)
         throw py::type_error(std::string("ibl.") + fn + ": model must be a built-in model name (" + builtin_names +
-                             "); Python models are taken by ibl.dfg and ibl.dfg_lut");
+                             "); Python models are taken by ibl.dfg, ibl.dfg_lut and ibl.dfg_albedo");
     return ma.b;
 }
 
@@ -502,7 +515,21 @@ py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, p
 }
 
 py::object dfg_albedo(py::object n_dot_v, py::object roughness, py::object model) {
-    const builtin b = builtin_only("dfg_albedo", model);
+    const model_arg ma = parse_model("dfg_albedo", model);
+    if (!ma.is_builtin) { // E of the kernel, as ibl::dfg_albedo takes it (dfg_exact_abe's e)
+        const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
+        broadcast_args<double> b = broadcast<double>("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}});
+        const std::vector<double> eb = python_dfg_eb(ma.obj, b.data[0], b.data[1], b.count);
+        if (b.scalar) return py::float_(f32 ? double(float(eb[0])) : eb[0]);
+        auto emit = [&](auto tag) -> py::object {
+            using T = decltype(tag);
+            py::array_t<T> out = make_output<T>(b.shape, 1);
+            for (std::size_t i = 0; i < b.count; ++i) out.mutable_data()[i] = T(eb[2 * i]);
+            return out;
+        };
+        return f32 ? emit(float{}) : emit(double{});
+    }
+    const builtin b = ma.b;
     return map("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 1, [&](auto tag) {
         using T = decltype(tag);
         return [b](const T* const* in, T* out) {
@@ -568,9 +595,9 @@ void bind_dfg(py::module_& m) {
           "(ibl::dfg_mc, the estimator of Karis 2013); 'vndf': visible normals (ibl::dfg_mc_vndf, Heitz /\n"
           "Dupuy). Samples below the horizon count as zeros. Built-in models only.");
     m.def("dfg_albedo", &dfg_albedo, py::arg("n_dot_v"), py::arg("roughness"), py::arg("model") = "ggx_height_correlated",
-          "The directional albedo E = A + B of a built-in model by the deterministic quadrature\n"
-          "(ibl::dfg_albedo, bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what\n"
-          "multiple scattering restores.");
+          "The directional albedo E = A + B by the deterministic quadrature (ibl::dfg_albedo,\n"
+          "bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what multiple scattering\n"
+          "restores. model: as ibl.dfg (a built-in name or a Python model object).");
     m.def(
         "dfg_energy_compensation",
         [](py::object albedo) {
