@@ -39,6 +39,43 @@ def bench_dfg(repeats=11):
           f"ratio {p / c:.2f}")
 
 
+def bench_prefilter(repeats=5, size=256):
+    """ibl.prefilter (default options) against the same chain computed by the C++ program
+    ibl_python_prefilter_ref (python/tests/prefilter_ref.cpp; its own timer around cubemap +
+    generate_mips + prefilter, so process start and file I/O are not counted), 1 thread and all
+    cores, interleaved. The cube: tests/data/courtyard.exr at size^2 when the readers are built."""
+    import os
+    import subprocess
+    import tempfile
+
+    import numpy as np
+    root = Path(__file__).resolve().parents[1]
+    exe = os.environ.get("IBL_PREFILTER_REF_EXE", str(root / "build/dev/python/ibl_python_prefilter_ref"))
+    if ibl.has_image_io:
+        cube = ibl.cube_from_latlong(ibl.read_image(str(root / "tests/data/courtyard.exr"), latlong=True), size)
+        what = "courtyard"
+    else:
+        cube = (np.random.default_rng(1).random((6, size, size, 3)) ** 4 * 8).astype(np.float32)
+        what = "random"
+    with tempfile.TemporaryDirectory() as tmp:
+        src, dst = Path(tmp) / "cube.f32", Path(tmp) / "chain.f32"
+        cube.tofile(src)
+        for threads in (1, 0):
+            nthreads = threads if threads else (os.cpu_count() or 1)
+            py, cpp = [], []
+            for _ in range(repeats):
+                t0 = time.perf_counter()
+                ibl.prefilter(cube, threads=threads)
+                py.append(time.perf_counter() - t0)
+                out = subprocess.run([exe, str(src), str(size), str(dst), "-1", "0", "fis", "n_dot_l", str(nthreads),
+                                      "--time"], check=True, capture_output=True, text=True).stdout
+                cpp.append(float(out.split()[1]))
+            p, c = statistics.median(py), statistics.median(cpp)
+            print(f"{size}^2 prefilter ({what}, default options), {nthreads} thread(s): Python {p:.3f} s, "
+                  f"C++ {c:.3f} s, Python / C++ {p / c:.3f} (medians of {repeats}, interleaved; "
+                  f"Python runs {', '.join(f'{x:.2f}' for x in py)}; C++ {', '.join(f'{x:.2f}' for x in cpp)})")
+
+
 if __name__ == "__main__":
     what = sys.argv[1] if len(sys.argv) > 1 else "dfg"
-    {"dfg": bench_dfg}[what]()
+    {"dfg": bench_dfg, "prefilter": bench_prefilter}[what]()

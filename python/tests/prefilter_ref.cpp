@@ -2,17 +2,20 @@
 // a cube as a program using the library computes it (cubemap, generate_mips, prefilter), written
 // independently of the binding, so that ibl.prefilter can be compared with it texel by texel.
 //
-//   ibl_python_prefilter_ref IN N OUT LEVELS SAMPLES METHOD WEIGHT THREADS
+//   ibl_python_prefilter_ref IN N OUT LEVELS SAMPLES METHOD WEIGHT THREADS [--time]
 //
 // IN: 6 N N 3 float32 values, native byte order, [face][y][x][rgb] with faces +X, -X, +Y, -Y, +Z,
 // -Z and (x, y) the texel of env/cube_geometry.hpp (the Python module's documented layout).
 // LEVELS: prefilter_options::levels (-1 automatic, 0 full chain); SAMPLES: options.samples (0 = the
 // default schedule); METHOD fis | fast | importance; WEIGHT n_dot_l | g1; THREADS for the executor.
 // OUT: every level in order, each 6 n n 3 float32 in the same layout. Exit 0, or 2 with a message.
+// --time: also print "seconds <t>", the wall time of cubemap + generate_mips + prefilter (what a
+// program using the library spends; python/bench.py compares ibl.prefilter with it).
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/core/executor.hpp>
 #include <ibl/env/cubemap.hpp>
 
+#include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -29,7 +32,8 @@ int fail(const std::string& msg) {
 } // namespace
 
 int main(int argc, char** argv) {
-    if (argc != 9) return fail("usage: IN N OUT LEVELS SAMPLES METHOD WEIGHT THREADS");
+    const bool timed = argc == 10 && std::string(argv[9]) == "--time";
+    if (argc != 9 && !timed) return fail("usage: IN N OUT LEVELS SAMPLES METHOD WEIGHT THREADS [--time]");
     try {
         const int n = std::atoi(argv[2]);
         if (n < 1 || n > 4096) return fail("bad N");
@@ -54,6 +58,7 @@ int main(int argc, char** argv) {
         std::fclose(f);
         if (got != count) return fail("IN holds fewer than 6 N N 3 floats");
 
+        const auto t0 = std::chrono::steady_clock::now();
         ibl::cubemap<float> cube(n);
         cube.fill(0, [&](int face, int x, int y) {
             const float* t = in.data() + ((std::size_t(face) * std::size_t(n) + std::size_t(y)) * std::size_t(n) + std::size_t(x)) * 3;
@@ -61,6 +66,8 @@ int main(int argc, char** argv) {
         });
         cube.generate_mips(ibl::thread_executor{threads});
         const ibl::specular_chain chain = ibl::prefilter(cube, opt, ibl::thread_executor{threads});
+        if (timed)
+            std::printf("seconds %.6f\n", std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
         std::FILE* o = std::fopen(argv[3], "wb");
         if (!o) return fail(std::string("cannot write ") + argv[3]);
