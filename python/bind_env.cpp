@@ -376,10 +376,90 @@ py::object extract_sun(py::object cube, double threshold_over_median, double thr
     return py::make_tuple(light, level_array(env, 0));
 }
 
+// ---- reference_radiance of a Python model: record / replay ------------------------------------------
+//
+// reference_radiance<Model> evaluates the model through brdf_lobe<Model>::eval: one Model::ndf and
+// then one Model::visibility call per lobe evaluation, whose number and order depend only on the
+// draws and their densities (GGX VNDF sampling with Model::alpha, the cosine lobe, the environment
+// distribution), never on the values returned. So, as the DFG of a Python model does, each point
+// runs twice: with rr_record_model, which stores the arguments of every call (returning 1), then,
+// after the Python ndf and visibility ran on those arrays (once per batch of points), with
+// rr_replay_model, which returns the model's values in the same order. The estimate, its batches,
+// MIS weights and error are the library's code; nothing of the estimator is restated.
+
+struct rr_buffer {
+    double alpha = 0.0;                  // the model's alpha for the point's roughness
+    double *nh = nullptr, *nv = nullptr, *nl = nullptr; // record: the point's slots
+    const double *d = nullptr, *v = nullptr;            // replay: the model's values
+    std::size_t n_ndf = 0, n_vis = 0, capacity = 0;
+};
+thread_local rr_buffer* tls_rr = nullptr;
+
+struct rr_record_model {
+    static constexpr const char* name = "python";
+    template <class T> static T alpha(T) noexcept { return T(tls_rr->alpha); }
+    template <class T> static T ndf(T n_dot_h, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        if (b.n_ndf < b.capacity) b.nh[b.n_ndf] = double(n_dot_h);
+        ++b.n_ndf;
+        return T(1);
+    }
+    template <class T> static T visibility(T n_dot_v, T n_dot_l, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        if (b.n_vis < b.capacity) {
+            b.nv[b.n_vis] = double(n_dot_v);
+            b.nl[b.n_vis] = double(n_dot_l);
+        }
+        ++b.n_vis;
+        return T(1);
+    }
+    template <class T> static T sample_weight(T, T, T, T, T) noexcept { return T(0); } // not used by brdf_lobe
+};
+struct rr_replay_model {
+    static constexpr const char* name = "python";
+    template <class T> static T alpha(T) noexcept { return T(tls_rr->alpha); }
+    template <class T> static T ndf(T, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        const std::size_t i = b.n_ndf++;
+        return i < b.capacity ? T(b.d[i]) : T(0);
+    }
+    template <class T> static T visibility(T, T, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        const std::size_t i = b.n_vis++;
+        return i < b.capacity ? T(b.v[i]) : T(0);
+    }
+    template <class T> static T sample_weight(T, T, T, T, T) noexcept { return T(0); }
+};
+static_assert(ibl::brdf_model<rr_record_model, double> && ibl::brdf_model<rr_replay_model, double>);
+
+struct rr_tls_guard {
+    explicit rr_tls_guard(rr_buffer* b) { tls_rr = b; }
+    ~rr_tls_guard() { tls_rr = nullptr; }
+    rr_tls_guard(const rr_tls_guard&) = delete;
+    rr_tls_guard& operator=(const rr_tls_guard&) = delete;
+};
+
 py::dict reference_radiance(py::object cube, py::object n, py::object v, py::object base_color, py::object metallic,
                             py::object roughness, long long samples, long long batches, std::uint32_t seed,
-                            const std::string& strategy, const std::string& diffuse, double dielectric_f0, unsigned threads) {
+                            const std::string& strategy, const std::string& diffuse, double dielectric_f0, unsigned threads,
+                            py::object model) {
     const char* fn = "reference_radiance";
+    bool py_model = false;
+    if (!model.is_none()) {
+        if (py::isinstance<py::str>(model)) {
+            const std::string name = model.cast<std::string>();
+            if (name != "ggx" && name != "ggx_height_correlated")
+                throw py::value_error("ibl.reference_radiance: model must be 'ggx_height_correlated' (alias 'ggx') or a "
+                                      "Python model object with alpha, ndf and visibility, got '" + name + "'");
+        } else {
+            py_model = true;
+            for (const char* f : {"alpha", "ndf", "visibility"})
+                if (!py::hasattr(model, f) || !PyCallable_Check(model.attr(f).ptr()))
+                    throw py::type_error(std::string("ibl.reference_radiance: the model object has no callable '") + f +
+                                         "' (needs alpha(roughness), ndf(n_dot_h, alpha), visibility(n_dot_v, n_dot_l, "
+                                         "roughness))");
+        }
+    }
     ibl::radiance_reference_options opt;
     if (samples < 1 || samples > (long long)ibl::limits::max_samples)
         throw py::value_error("ibl.reference_radiance: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) +
@@ -417,24 +497,120 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
     const ibl::cubemap<float> env = to_cubemap(fn, cube, threads);
     std::optional<ibl::cube_env_distribution> dist;
     std::vector<double> out(b.count * 12);
+    auto material = [&](std::size_t i) {
+        const double* c = b.data[2] + 3 * i;
+        return ibl::make_reference_material(ibl::vec3<double>(c[0], c[1], c[2]), b.data[3][i], b.data[4][i], dw, dielectric_f0);
+    };
+    auto store = [&](std::size_t i, const ibl::radiance_estimate& e) {
+        const ibl::vec3<double>* parts[4] = {&e.value, &e.diffuse, &e.specular, &e.std_error};
+        for (int p = 0; p < 4; ++p)
+            for (int c = 0; c < 3; ++c) out[(std::size_t(p) * b.count + i) * 3 + std::size_t(c)] = (*parts[p])[c];
+    };
+    auto point = [&](auto model_tag, std::size_t i) {
+        using M = decltype(model_tag);
+        auto vec = [&](int k) {
+            const double* d = b.data[std::size_t(k)] + 3 * i;
+            return ibl::vec3<double>(d[0], d[1], d[2]);
+        };
+        return ibl::reference_radiance<M>(env, dist ? &*dist : nullptr, glm::normalize(vec(0)), glm::normalize(vec(1)),
+                                          material(i), opt);
+    };
     {
         py::gil_scoped_release release;
         if (opt.strategy != ibl::radiance_strategy::brdf) dist.emplace(env);
+    }
+    if (!py_model) {
+        py::gil_scoped_release release;
         ibl::thread_executor{threads}(b.count, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) {
-                auto vec = [&](int k) {
-                    const double* d = b.data[std::size_t(k)] + 3 * i;
-                    return ibl::vec3<double>(d[0], d[1], d[2]);
-                };
-                const ibl::reference_material mat =
-                    ibl::make_reference_material(vec(2), b.data[3][i], b.data[4][i], dw, dielectric_f0);
-                const ibl::radiance_estimate e = ibl::reference_radiance(env, dist ? &*dist : nullptr, glm::normalize(vec(0)),
-                                                                         glm::normalize(vec(1)), mat, opt);
-                const ibl::vec3<double>* parts[4] = {&e.value, &e.diffuse, &e.specular, &e.std_error};
-                for (int p = 0; p < 4; ++p)
-                    for (int c = 0; c < 3; ++c) out[(std::size_t(p) * b.count + i) * 3 + std::size_t(c)] = (*parts[p])[c];
-            }
+            for (std::size_t i = begin; i < end; ++i) store(i, point(ibl::ggx_height_correlated{}, i));
         });
+    } else {
+        // at most samples lobe evaluations per point (one per draw); points in batches of <= 2^16 slots
+        const std::size_t cap = std::size_t(opt.samples);
+        const std::size_t per_batch = std::max<std::size_t>(1, (std::size_t(1) << 16) / cap);
+        for (std::size_t p0 = 0; p0 < b.count; p0 += per_batch) {
+            const std::size_t p1 = std::min(b.count, p0 + per_batch), m = p1 - p0;
+            py::array_t<double> rough(static_cast<py::ssize_t>(m));
+            for (std::size_t i = 0; i < m; ++i) rough.mutable_data()[i] = material(p0 + i).roughness;
+            py::array_t<double> alpha_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+                model.attr("alpha")(rough));
+            if (!alpha_arr || !(alpha_arr.ndim() == 0 || (alpha_arr.ndim() == 1 && std::size_t(alpha_arr.shape(0)) == m)))
+                throw py::value_error("ibl.reference_radiance: model.alpha must return a real scalar or an array of shape (" +
+                                      std::to_string(m) + ",)");
+            std::vector<rr_buffer> bufs(m);
+            std::vector<double> nh(m * cap), nv(m * cap), nl(m * cap);
+            for (std::size_t i = 0; i < m; ++i) {
+                const double a = alpha_arr.ndim() == 0 ? *alpha_arr.data() : alpha_arr.data()[i];
+                if (!std::isfinite(a) || a < 0.0)
+                    throw py::value_error("ibl.reference_radiance: model.alpha returned " + std::to_string(a) +
+                                          " for roughness " + std::to_string(rough.data()[i]) + " (must be finite and >= 0)");
+                bufs[i].alpha = a;
+                bufs[i].nh = nh.data() + i * cap;
+                bufs[i].nv = nv.data() + i * cap;
+                bufs[i].nl = nl.data() + i * cap;
+                bufs[i].capacity = cap;
+            }
+            {
+                py::gil_scoped_release release;
+                ibl::thread_executor{threads}(m, [&](std::size_t begin, std::size_t end) {
+                    for (std::size_t i = begin; i < end; ++i) {
+                        rr_tls_guard g(&bufs[i]);
+                        point(rr_record_model{}, p0 + i);
+                    }
+                });
+            }
+            // the recorded calls of the batch, packed: point i's first count_i slots
+            std::size_t total = 0;
+            for (const rr_buffer& rb : bufs) {
+                if (rb.n_ndf != rb.n_vis || rb.n_ndf > cap)
+                    throw std::logic_error("ibl.reference_radiance: unexpected model call pattern");
+                total += rb.n_ndf;
+            }
+            py::array_t<double> a_nh(static_cast<py::ssize_t>(total)), a_al(static_cast<py::ssize_t>(total)),
+                a_nv(static_cast<py::ssize_t>(total)), a_nl(static_cast<py::ssize_t>(total)), a_r(static_cast<py::ssize_t>(total));
+            std::vector<std::size_t> offset(m);
+            for (std::size_t i = 0, at = 0; i < m; ++i) {
+                offset[i] = at;
+                for (std::size_t k = 0; k < bufs[i].n_ndf; ++k, ++at) {
+                    a_nh.mutable_data()[at] = bufs[i].nh[k];
+                    a_al.mutable_data()[at] = bufs[i].alpha;
+                    a_nv.mutable_data()[at] = bufs[i].nv[k];
+                    a_nl.mutable_data()[at] = bufs[i].nl[k];
+                    a_r.mutable_data()[at] = rough.data()[i];
+                }
+            }
+            auto values = [&](py::object r, const char* fn_name) {
+                auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
+                if (!a || !(a.ndim() == 0 || (a.ndim() == 1 && std::size_t(a.shape(0)) == total)))
+                    throw py::value_error(std::string("ibl.reference_radiance: model.") + fn_name +
+                                          " must return a real scalar or an array of shape (" + std::to_string(total) + ",)");
+                std::vector<double> vals(total);
+                for (std::size_t k = 0; k < total; ++k) {
+                    vals[k] = a.ndim() == 0 ? *a.data() : a.data()[k];
+                    if (!std::isfinite(vals[k]))
+                        throw py::value_error(std::string("ibl.reference_radiance: model.") + fn_name + " returned " +
+                                              std::to_string(vals[k]) + " at n_dot_v=" + std::to_string(a_nv.data()[k]) +
+                                              ", n_dot_l=" + std::to_string(a_nl.data()[k]) + ", n_dot_h=" +
+                                              std::to_string(a_nh.data()[k]) + ", roughness=" + std::to_string(a_r.data()[k]) +
+                                              " (must be finite)");
+                }
+                return vals;
+            };
+            const std::vector<double> dv = values(model.attr("ndf")(a_nh, a_al), "ndf");
+            const std::vector<double> vv = values(model.attr("visibility")(a_nv, a_nl, a_r), "visibility");
+            py::gil_scoped_release release;
+            ibl::thread_executor{threads}(m, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i) {
+                    rr_buffer rep{};
+                    rep.alpha = bufs[i].alpha;
+                    rep.d = dv.data() + offset[i];
+                    rep.v = vv.data() + offset[i];
+                    rep.capacity = bufs[i].n_ndf;
+                    rr_tls_guard g(&rep);
+                    store(p0 + i, point(rr_replay_model{}, p0 + i));
+                }
+            });
+        }
     }
     py::dict result;
     const char* names[4] = {"value", "diffuse", "specular", "std_error"};
@@ -492,7 +668,7 @@ void bind_env(py::module_& m) {
     m.def("reference_radiance", &reference_radiance, py::arg("cube"), py::arg("n"), py::arg("v"), py::arg("base_color"),
           py::arg("metallic"), py::arg("roughness"), py::kw_only(), py::arg("samples") = 4096, py::arg("batches") = 16,
           py::arg("seed") = 0u, py::arg("strategy") = "mis", py::arg("diffuse") = "lambert", py::arg("dielectric_f0") = 0.04,
-          py::arg("threads") = 0u,
+          py::arg("threads") = 0u, py::arg("model") = py::none(),
           "Outgoing radiance Lo(n, v) of a metallic-roughness material under the cube WITHOUT the split sum\n"
           "(ibl::reference_radiance, reference/radiance.hpp: GGX height-correlated specular + Lambert, single\n"
           "scattering, F90 = 1), by multiple importance sampling of the BRDF and the environment (randomised\n"
@@ -500,7 +676,10 @@ void bind_env(py::module_& m) {
           "(normalised here), base_color (..., 3), metallic, roughness broadcast; all in [0, 1] but n, v.\n"
           "strategy 'mis', 'brdf' or 'env'; diffuse 'lambert' (k_d = 1) or 'one_minus_fresnel_roughness' (the\n"
           "single-scattering shader's kD). Returns a dict of float64 arrays (..., 3): 'value', 'diffuse',\n"
-          "'specular' and 'std_error' (of value, from the batch means). Deterministic for given inputs.");
+          "'specular' and 'std_error' (of value, from the batch means). Deterministic for given inputs.\n"
+          "model: None or 'ggx' (GGX height-correlated), or a Python model with alpha(roughness),\n"
+          "ndf(n_dot_h, alpha), visibility(n_dot_v, n_dot_l, roughness): the same estimator run twice per\n"
+          "batch of points (record the calls, evaluate the model once per batch, replay its values).");
 }
 
 } // namespace ibl_py

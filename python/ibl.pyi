@@ -98,7 +98,10 @@ def extract_sun(cube: ArrayLike, *, threshold_over_median: float = 50.0, thresho
 def reference_radiance(cube: ArrayLike, n: ArrayLike, v: ArrayLike, base_color: ArrayLike, metallic: ArrayLike,
                        roughness: ArrayLike, *, samples: int = 4096, batches: int = 16, seed: int = 0,
                        strategy: str = "mis", diffuse: str = "lambert", dielectric_f0: float = 0.04,
-                       threads: int = 0) -> dict[str, np.ndarray]: ...  # value, diffuse, specular, std_error: (..., 3)
+                       threads: int = 0, model: Union[None, str, BRDFModel] = None
+                       ) -> dict[str, np.ndarray]: ...  # value, diffuse, specular, std_error: (..., 3)
+# reference_radiance model: None / "ggx" (GGX height-correlated) or a Python model with alpha, ndf and
+# visibility (sample_weight is not used), evaluated once per batch of points on the recorded calls
 
 # ---- files (the bake tool's I/O library; has_image_io False: RuntimeError) ----
 has_image_io: bool
