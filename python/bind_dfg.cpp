@@ -483,16 +483,68 @@ py::array_t<float> dfg_lut(long long size, py::object model, const std::string& 
 
 // ---- Monte Carlo DFG and the multiscatter energy terms (built-in models) ----------------------------
 
-builtin builtin_only(const char* fn, py::object model) {
-    const model_arg ma = parse_model(fn, model);
-    if (!ma.is_builtin)
-        throw py::type_error(std::string("ibl.") + fn + ": model must be a built-in model name (" + builtin_names +
-                             "); Python models are taken by ibl.dfg, ibl.dfg_lut and ibl.dfg_albedo");
-    return ma.b;
+
+/// dfg_mc / dfg_mc_vndf of a Python model in T (the built-in path's precision): both estimators call
+/// Model::sample_weight once per draw, in draw order, whatever the values; so the record / replay
+/// passes of the file header apply, per batch of whole points (samples nodes each).
+template <class T>
+std::vector<T> python_dfg_mc(const py::object& obj, const double* mu, const double* r, std::size_t count, std::uint32_t samples,
+                             bool vndf) {
+    std::vector<T> ab(2 * count);
+    const python_model pm(obj);
+    const std::size_t evals = samples;
+    const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
+    batch_nodes nodes(std::min(count, per_batch) * evals);
+    auto run = [&](auto model_tag, std::size_t i) {
+        using M = decltype(model_tag);
+        return vndf ? ibl::dfg_mc_vndf<M>(T(mu[i]), T(r[i]), samples) : ibl::dfg_mc<M>(T(mu[i]), T(r[i]), samples);
+    };
+    for (std::size_t begin = 0; begin < count; begin += per_batch) {
+        const std::size_t end = std::min(count, begin + per_batch), m = end - begin;
+        std::vector<double> rb(m);
+        for (std::size_t i = 0; i < m; ++i) rb[i] = double(T(r[begin + i])); // the roughness the estimator sees
+        const std::vector<double> alpha = pm.alpha(rb);
+        nodes.use(m * evals);
+        node_buffer buf{};
+        {
+            py::gil_scoped_release release;
+            tls_guard g(&buf);
+            buf.nv = nodes.data[0];
+            buf.nl = nodes.data[1];
+            buf.nh = nodes.data[2];
+            buf.vh = nodes.data[3];
+            buf.capacity = nodes.n;
+            for (std::size_t i = 0; i < m; ++i) {
+                buf.alpha = alpha[i];
+                run(recording_model{}, begin + i);
+                if (buf.cursor != (i + 1) * evals) throw std::logic_error("ibl.dfg_mc: the estimator's call count changed");
+                std::fill(nodes.data[4] + i * evals, nodes.data[4] + (i + 1) * evals, rb[i]);
+                std::fill(nodes.data[5] + i * evals, nodes.data[5] + (i + 1) * evals, alpha[i]);
+            }
+        }
+        if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg_mc: the estimator's call count changed");
+        const python_model::values vals =
+            pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
+        py::gil_scoped_release release;
+        node_buffer rep{};
+        tls_guard g(&rep);
+        rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
+        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
+        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
+        rep.capacity = nodes.n;
+        for (std::size_t i = 0; i < m; ++i) {
+            rep.alpha = alpha[i];
+            rep.cursor = i * evals;
+            const ibl::vec2<T> v = run(replay_model{}, begin + i);
+            ab[2 * (begin + i)] = v.x;
+            ab[2 * (begin + i) + 1] = v.y;
+        }
+    }
+    return ab;
 }
 
 py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, py::object model, const std::string& sampling) {
-    const builtin b = builtin_only("dfg_mc", model);
+    const model_arg ma = parse_model("dfg_mc", model);
     if (samples < 1 || samples > (long long)ibl::limits::max_samples)
         throw py::value_error("ibl.dfg_mc: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) + "], got " +
                               std::to_string(samples));
@@ -501,6 +553,19 @@ py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, p
     else if (sampling == "vndf") vndf = true;
     else throw py::value_error("ibl.dfg_mc: sampling must be 'ndf' or 'vndf', got '" + sampling + "'");
     const auto n = std::uint32_t(samples);
+    if (!ma.is_builtin) {
+        const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
+        broadcast_args<double> b = broadcast<double>("dfg_mc", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}});
+        auto emit = [&](auto tag) -> py::object {
+            using T = decltype(tag);
+            const std::vector<T> ab = python_dfg_mc<T>(ma.obj, b.data[0], b.data[1], b.count, n, vndf);
+            py::array_t<T> out = make_output<T>(b.shape, 2);
+            std::copy(ab.begin(), ab.end(), out.mutable_data());
+            return out;
+        };
+        return f32 ? emit(float{}) : emit(double{});
+    }
+    const builtin b = ma.b;
     return map("dfg_mc", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 2, [&](auto tag) {
         using T = decltype(tag);
         return [b, n, vndf](const T* const* in, T* out) {
@@ -593,7 +658,7 @@ void bind_dfg(py::module_& m) {
           "Split-sum DFG terms (A, B) by Monte Carlo with `samples` Hammersley points: array (..., 2) over the\n"
           "broadcast shape of n_dot_v and roughness (in [0, 1]). sampling 'ndf': GGX NDF importance sampling\n"
           "(ibl::dfg_mc, the estimator of Karis 2013); 'vndf': visible normals (ibl::dfg_mc_vndf, Heitz /\n"
-          "Dupuy). Samples below the horizon count as zeros. Built-in models only.");
+          "Dupuy). Samples below the horizon count as zeros. model: as ibl.dfg.");
     m.def("dfg_albedo", &dfg_albedo, py::arg("n_dot_v"), py::arg("roughness"), py::arg("model") = "ggx_height_correlated",
           "The directional albedo E = A + B by the deterministic quadrature (ibl::dfg_albedo,\n"
           "bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what multiple scattering\n"

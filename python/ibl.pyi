@@ -64,8 +64,8 @@ def dfg_lut(size: int, model: Model = "ggx_height_correlated", *, layout: str = 
             multiscatter: bool = False, threads: int = 0) -> np.ndarray: ...  # float32 (size, size, 2 or 3)
 def dfg_smooth_limit(n_dot_v: ArrayLike) -> np.ndarray: ...  # (..., 2)
 def dfg_lut_coords(size: int, layout: str = "uniform") -> tuple[np.ndarray, np.ndarray]: ...  # (n_dot_v, roughness)
-def dfg_mc(n_dot_v: ArrayLike, roughness: ArrayLike, samples: int = 1024, model: str = "ggx_height_correlated", *,
-           sampling: str = "ndf") -> np.ndarray: ...  # (..., 2); sampling "ndf" | "vndf"; built-in models only
+def dfg_mc(n_dot_v: ArrayLike, roughness: ArrayLike, samples: int = 1024, model: Model = "ggx_height_correlated", *,
+           sampling: str = "ndf") -> np.ndarray: ...  # (..., 2); sampling "ndf" | "vndf"
 def dfg_albedo(n_dot_v: ArrayLike, roughness: ArrayLike, model: Model = "ggx_height_correlated") -> Real: ...  # E = A + B
 def dfg_energy_compensation(albedo: ArrayLike) -> Real: ...  # (1 - E) / E
 
