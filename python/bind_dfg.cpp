@@ -1,15 +1,15 @@
 // python/bind_dfg.cpp — the split-sum DFG terms of built-in C++ models and of BRDF models written in
 // Python.
 //
-// A Python model is evaluated once per batch, never per node. The library's own quadrature
+// A Python model is evaluated once per batch of nodes (at most max_batch_nodes), never per node. The library's own quadrature
 // (ibl::dfg_quadrature_lanes, the path of dfg_exact and make_dfg_lut_exact) runs twice per batch:
 //   1. with recording_model, whose sample_weight stores its arguments (n.v, n.l, n.h, v.h) in call
 //      order and returns 0: the nodes of the rule, exactly as the C++ path forms them;
-//   2. the Python functions are called on those arrays, and the binding forms the weight of
-//      brdf/model.hpp, w = 4 (V n.l) sat(v.h) / n.h * (D_M / D_ggx) (0 where n.l <= 0 or n.h <= 0),
-//      or takes the model's own sample_weight;
-//   3. with replay_model, whose sample_weight returns those weights in the same order: the sums,
-//      their order and the node weights are the library's.
+//   2. the Python functions are called on those arrays (their values checked for finiteness);
+//   3. with replay_model, whose sample_weight returns the weight of each node in the same order:
+//      brdf/model.hpp's w = 4 (V n.l) sat(v.h) / n.h * (D_M / D_ggx) (0 where n.l <= 0 or
+//      n.h <= 0), formed in double from the model's values and the node, or the model's own
+//      sample_weight. The sums, their order and the node weights are the library's.
 // So a Python model equal to a C++ model gives the C++ result up to the rounding of its own
 // arithmetic (tables: the weight rounds through float, as in make_dfg_lut_exact).
 #include "common.hpp"
@@ -58,7 +58,8 @@ static_assert(ibl::brdf_model<blinn_phong_model, float> && ibl::brdf_model<blinn
 struct node_buffer {
     double alpha = 0.0;                // the model's alpha of the current texel / row
     double *nv, *nl, *nh, *vh;         // recording: where the next node goes
-    const double* w;                   // replay: the next weight
+    // replay: the model's values of the next node: sample_weight (s), or ndf (d) and visibility (v)
+    const double *s = nullptr, *d = nullptr, *v = nullptr;
     std::size_t cursor = 0, capacity = 0;
 };
 thread_local node_buffer* tls_nodes = nullptr;
@@ -77,13 +78,22 @@ struct recording_model {
         return T(0);
     }
 };
+/// The weight of the node in replay: the model's sample_weight, or brdf/model.hpp's weight from
+/// its ndf and visibility, formed in double from the node's values as recorded (the arguments,
+/// which are the recorded values before their conversion to double): 4 (V n.l) sat(v.h) / n.h *
+/// D_M / D_ggx, 0 where n.l <= 0 or n.h <= 0.
 struct replay_model {
     template <class T> static T alpha(T) noexcept { return T(tls_nodes->alpha); }
-    template <class T> static T sample_weight(T, T, T, T, T) noexcept {
+    template <class T> static T sample_weight(T, T n_dot_l, T n_dot_h, T v_dot_h, T) noexcept {
         node_buffer& b = *tls_nodes;
-        const T w = b.cursor < b.capacity ? T(b.w[b.cursor]) : T(0);
-        ++b.cursor;
-        return w;
+        const std::size_t i = b.cursor++;
+        if (i >= b.capacity) return T(0);
+        if (b.s) return T(b.s[i]);
+        const double l = double(n_dot_l), h = double(n_dot_h);
+        const double dg = ibl::ndf_ggx(h, b.alpha);
+        const double ratio = dg > 0.0 ? b.d[i] / dg : 0.0;
+        const double w = ibl::weight_ggx_sampled(b.v[i], l, h, double(v_dot_h)) * ratio;
+        return T(l > 0.0 && h > 0.0 ? w : 0.0);
     }
 };
 
@@ -94,8 +104,11 @@ struct tls_guard {
     tls_guard& operator=(const tls_guard&) = delete;
 };
 
-/// Nodes per batch: the Python functions see arrays of at most this length (memory ~ 10 doubles a node).
-constexpr std::size_t max_batch_nodes = std::size_t(1) << 21;
+/// Nodes per batch: the Python functions see arrays of at most this length (whole texels, whole
+/// table rows). Small enough that a NumPy model's arrays and temporaries stay in cache and are reused
+/// by the allocator: a 64^2 table in batches of 2^16 nodes took 128 ms against 200 ms in one batch of
+/// 1.8 M nodes (docs/python.md, "BRDF models"); 2^14 to 2^16 measured alike, 2^18 and up as one batch.
+constexpr std::size_t max_batch_nodes = std::size_t(1) << 16;
 
 // ---- the Python model ----------------------------------------------------------------------------
 
@@ -147,49 +160,79 @@ struct python_model {
         return out;
     }
 
-    /// The split-sum weights of n nodes (brdf/model.hpp's sample_weight).
-    void weights(std::size_t n, const py::array_t<double>& nv, const py::array_t<double>& nl, const py::array_t<double>& nh,
-                 const py::array_t<double>& vh, const py::array_t<double>& rough, const py::array_t<double>& alpha,
-                 double* w) const {
-        auto check = [&](const double* p, const char* fn, bool only_valid) {
+    /// The model's values at n nodes, checked: sample_weight finite at every node, or ndf and
+    /// visibility finite wherever n.l > 0 and n.h > 0 (replay_model forms the weight). One pass
+    /// sums x - x of the checked values (NaN once one is NaN or infinite); only then a second pass
+    /// finds the first offending node for the message.
+    struct values {
+        py::array_t<double> s, d, v;
+    };
+    values evaluate(std::size_t n, const py::array_t<double>& nv, const py::array_t<double>& nl, const py::array_t<double>& nh,
+                    const py::array_t<double>& vh, const py::array_t<double>& rough, const py::array_t<double>& alpha) const {
+        const double *pnv = nv.data(), *pl = nl.data(), *ph = nh.data(), *pr = rough.data();
+        auto fail = [&](const double* p, const char* fn, bool only_valid) {
             for (std::size_t i = 0; i < n; ++i) {
-                if (only_valid && !(nl.data()[i] > 0.0 && nh.data()[i] > 0.0)) continue;
+                if (only_valid && !(pl[i] > 0.0 && ph[i] > 0.0)) continue;
                 if (!std::isfinite(p[i]))
                     throw py::value_error(std::string("ibl: model.") + fn + " returned " + std::to_string(p[i]) +
-                                          " at n_dot_v=" + std::to_string(nv.data()[i]) + ", n_dot_l=" +
-                                          std::to_string(nl.data()[i]) + ", n_dot_h=" + std::to_string(nh.data()[i]) +
-                                          ", roughness=" + std::to_string(rough.data()[i]) + " (must be finite)");
+                                          " at n_dot_v=" + std::to_string(pnv[i]) + ", n_dot_l=" + std::to_string(pl[i]) +
+                                          ", n_dot_h=" + std::to_string(ph[i]) + ", roughness=" + std::to_string(pr[i]) +
+                                          " (must be finite)");
             }
         };
+        values out;
         if (has_sample_weight) {
-            py::array_t<double> s = model_result(obj.attr("sample_weight")(nv, nl, nh, vh, rough), "sample_weight", n);
-            check(s.data(), "sample_weight", false);
-            std::copy(s.data(), s.data() + n, w);
-            return;
+            out.s = model_result(obj.attr("sample_weight")(nv, nl, nh, vh, rough), "sample_weight", n);
+            const double* ps = out.s.data();
+            double probe = 0.0;
+            {
+                py::gil_scoped_release release;
+                for (std::size_t i = 0; i < n; ++i) probe += ps[i] - ps[i];
+            }
+            if (!(probe == 0.0)) fail(ps, "sample_weight", false);
+            return out;
         }
-        py::array_t<double> d = model_result(obj.attr("ndf")(nh, alpha), "ndf", n);
-        py::array_t<double> v = model_result(obj.attr("visibility")(nv, nl, rough), "visibility", n);
-        check(d.data(), "ndf", true);
-        check(v.data(), "visibility", true);
-        const double *pd = d.data(), *pv = v.data(), *pl = nl.data(), *ph = nh.data(), *pvh = vh.data(), *pa = alpha.data();
-        py::gil_scoped_release release;
-        for (std::size_t i = 0; i < n; ++i) {
-            const double dg = ibl::ndf_ggx(ph[i], pa[i]);
-            const double ratio = dg > 0.0 ? pd[i] / dg : 0.0;
-            w[i] = ibl::weight_ggx_sampled(pv[i], pl[i], ph[i], pvh[i]) * ratio;
+        out.d = model_result(obj.attr("ndf")(nh, alpha), "ndf", n);
+        out.v = model_result(obj.attr("visibility")(nv, nl, rough), "visibility", n);
+        const double *pd = out.d.data(), *pv = out.v.data();
+        double probe = 0.0;
+        {
+            py::gil_scoped_release release;
+            for (std::size_t i = 0; i < n; ++i)
+                probe += pl[i] > 0.0 && ph[i] > 0.0 ? (pd[i] - pd[i]) + (pv[i] - pv[i]) : 0.0;
         }
+        if (!(probe == 0.0)) {
+            fail(pd, "ndf", true);
+            fail(pv, "visibility", true);
+        }
+        return out;
     }
 };
 
-/// A batch of texels sharing the node structure: `groups` kernel calls, each of `lanes` texels
-/// with one roughness; nodes per call = lanes * evaluations, in the kernel's call order.
+/// The node arrays of the batches of one call: storage for the largest batch, allocated once, and
+/// per batch views of its first n nodes (fresh arrays per batch would be fresh pages per batch).
+/// A store is replaced by a new one when anything besides these views still references it (a
+/// model that kept an input array keeps what it was given).
 struct batch_nodes {
+    static constexpr int arrays = 6;
     std::size_t n = 0;
-    py::array_t<double> nv, nl, nh, vh, rough, alpha;
-    std::vector<double> w;
-    explicit batch_nodes(std::size_t count)
-        : n(count), nv(py::ssize_t(count)), nl(py::ssize_t(count)), nh(py::ssize_t(count)), vh(py::ssize_t(count)),
-          rough(py::ssize_t(count)), alpha(py::ssize_t(count)), w(count) {}
+    py::array_t<double> store[arrays];
+    py::array_t<double> view[arrays]; // nv, nl, nh, vh, rough, alpha
+    double* data[arrays] = {};
+    bool used = false;
+    explicit batch_nodes(std::size_t capacity) {
+        for (auto& a : store) a = py::array_t<double>(py::ssize_t(capacity));
+    }
+    void use(std::size_t count) {
+        n = count;
+        for (int k = 0; k < arrays; ++k) {
+            // our references: store[k] itself and the view's base (while the view lives)
+            if (used && (view[k].ref_count() > 1 || store[k].ref_count() > 2)) store[k] = py::array_t<double>(store[k].size());
+            data[k] = store[k].mutable_data();
+            view[k] = py::array_t<double>({py::ssize_t(count)}, {py::ssize_t(sizeof(double))}, data[k], store[k]);
+        }
+        used = true;
+    }
 };
 
 // ---- built-in models -----------------------------------------------------------------------------
@@ -235,6 +278,60 @@ model_arg parse_model(const char* fn, py::object model) {
 
 // ---- ibl.dfg ---------------------------------------------------------------------------------------
 
+/// E = A + B and B of n points for a Python model: the default rule of dfg_exact, the kernel run
+/// as the file header describes, per batch of whole points. Output: eb[2 i] = E, eb[2 i + 1] = B.
+std::vector<double> python_dfg_eb(const py::object& obj, const double* mu, const double* r, std::size_t n) {
+    std::vector<double> eb(2 * n);
+    const python_model pm(obj);
+    const ibl::dfg_quadrature_rule& rule = ibl::default_dfg_quadrature_rule();
+    const ibl::dfg_quadrature_view q = rule.view();
+    const std::size_t evals = rule.nodes().evaluations();
+    const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
+    batch_nodes nodes(std::min(n, per_batch) * evals);
+    for (std::size_t begin = 0; begin < n; begin += per_batch) {
+        const std::size_t end = std::min(n, begin + per_batch), m = end - begin;
+        const std::vector<double> alpha = pm.alpha(std::vector<double>(r + begin, r + end));
+        nodes.use(m * evals);
+        node_buffer buf{};
+        {
+            py::gil_scoped_release release;
+            tls_guard g(&buf);
+            buf.nv = nodes.data[0];
+            buf.nl = nodes.data[1];
+            buf.nh = nodes.data[2];
+            buf.vh = nodes.data[3];
+            buf.capacity = nodes.n;
+            double* pr = nodes.data[4];
+            double* pa = nodes.data[5];
+            for (std::size_t i = 0; i < m; ++i) {
+                buf.alpha = alpha[i];
+                double e, bb;
+                ibl::dfg_quadrature_lanes<recording_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
+                std::fill(pr + i * evals, pr + (i + 1) * evals, r[begin + i]);
+                std::fill(pa + i * evals, pa + (i + 1) * evals, alpha[i]);
+            }
+        }
+        if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg: the quadrature's node count changed");
+        const python_model::values vals = pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
+        py::gil_scoped_release release;
+        node_buffer rep{};
+        tls_guard g(&rep);
+        rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
+        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
+        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
+        rep.capacity = nodes.n;
+        for (std::size_t i = 0; i < m; ++i) {
+            rep.alpha = alpha[i];
+            double e, bb;
+            ibl::dfg_quadrature_lanes<replay_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
+            eb[2 * (begin + i)] = e;
+            eb[2 * (begin + i) + 1] = bb;
+        }
+    }
+    return eb;
+}
+
+
 py::object dfg(py::object n_dot_v, py::object roughness, py::object model, unsigned threads) {
     const model_arg ma = parse_model("dfg", model);
     const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
@@ -256,48 +353,10 @@ py::object dfg(py::object n_dot_v, py::object roughness, py::object model, unsig
             });
         });
     } else {
-        const python_model pm(ma.obj);
-        const ibl::dfg_quadrature_rule& rule = ibl::default_dfg_quadrature_rule();
-        const ibl::dfg_quadrature_view q = rule.view();
-        const std::size_t evals = rule.nodes().evaluations();
-        const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
-        for (std::size_t begin = 0; begin < n; begin += per_batch) {
-            const std::size_t end = std::min(n, begin + per_batch), m = end - begin;
-            const std::vector<double> alpha = pm.alpha(std::vector<double>(r + begin, r + end));
-            batch_nodes nodes(m * evals);
-            node_buffer buf{};
-            {
-                py::gil_scoped_release release;
-                tls_guard g(&buf);
-                buf.nv = nodes.nv.mutable_data();
-                buf.nl = nodes.nl.mutable_data();
-                buf.nh = nodes.nh.mutable_data();
-                buf.vh = nodes.vh.mutable_data();
-                buf.capacity = nodes.n;
-                double* pr = nodes.rough.mutable_data();
-                double* pa = nodes.alpha.mutable_data();
-                for (std::size_t i = 0; i < m; ++i) {
-                    buf.alpha = alpha[i];
-                    double e, bb;
-                    ibl::dfg_quadrature_lanes<recording_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
-                    std::fill(pr + i * evals, pr + (i + 1) * evals, r[begin + i]);
-                    std::fill(pa + i * evals, pa + (i + 1) * evals, alpha[i]);
-                }
-            }
-            if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg: the quadrature's node count changed");
-            pm.weights(nodes.n, nodes.nv, nodes.nl, nodes.nh, nodes.vh, nodes.rough, nodes.alpha, nodes.w.data());
-            py::gil_scoped_release release;
-            node_buffer rep{};
-            tls_guard g(&rep);
-            rep.w = nodes.w.data();
-            rep.capacity = nodes.n;
-            for (std::size_t i = 0; i < m; ++i) {
-                rep.alpha = alpha[i];
-                double e, bb;
-                ibl::dfg_quadrature_lanes<replay_model, 1>(q, r[begin + i], &mu[begin + i], &e, &bb);
-                ab[2 * (begin + i)] = e - bb;
-                ab[2 * (begin + i) + 1] = bb;
-            }
+        const std::vector<double> eb = python_dfg_eb(ma.obj, mu, r, n);
+        for (std::size_t i = 0; i < n; ++i) {
+            ab[2 * i] = eb[2 * i] - eb[2 * i + 1];
+            ab[2 * i + 1] = eb[2 * i + 1];
         }
     }
     auto emit = [&](auto tag) {
@@ -324,6 +383,7 @@ ibl::dfg_lut python_dfg_lut(const python_model& pm, std::uint32_t size, const ib
     const ibl::dfg_quadrature_view q = rule.view();
     const std::size_t row_nodes = std::size_t(size) * qn.evaluations();
     const std::size_t rows_per_batch = std::max<std::size_t>(1, max_batch_nodes / row_nodes);
+    batch_nodes nodes(std::min<std::size_t>(size, rows_per_batch) * row_nodes);
     // The kernel calls of one row, in make_dfg_lut_exact's order: W-lane groups, then single texels.
     auto row_calls = [&](std::uint32_t j, auto model_tag) {
         using M = decltype(model_tag);
@@ -359,18 +419,18 @@ ibl::dfg_lut python_dfg_lut(const python_model& pm, std::uint32_t size, const ib
         }
         if (rows.empty()) continue;
         const std::vector<double> alpha = pm.alpha(rs);
-        batch_nodes nodes(rows.size() * row_nodes);
+        nodes.use(rows.size() * row_nodes);
         node_buffer buf{};
         {
             py::gil_scoped_release release;
             tls_guard g(&buf);
-            buf.nv = nodes.nv.mutable_data();
-            buf.nl = nodes.nl.mutable_data();
-            buf.nh = nodes.nh.mutable_data();
-            buf.vh = nodes.vh.mutable_data();
+            buf.nv = nodes.data[0];
+            buf.nl = nodes.data[1];
+            buf.nh = nodes.data[2];
+            buf.vh = nodes.data[3];
             buf.capacity = nodes.n;
-            double* pr = nodes.rough.mutable_data();
-            double* pa = nodes.alpha.mutable_data();
+            double* pr = nodes.data[4];
+            double* pa = nodes.data[5];
             for (std::size_t k = 0; k < rows.size(); ++k) {
                 buf.alpha = alpha[k];
                 row_calls(rows[k], recording_model{});
@@ -379,11 +439,13 @@ ibl::dfg_lut python_dfg_lut(const python_model& pm, std::uint32_t size, const ib
             }
         }
         if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg_lut: the quadrature's node count changed");
-        pm.weights(nodes.n, nodes.nv, nodes.nl, nodes.nh, nodes.vh, nodes.rough, nodes.alpha, nodes.w.data());
+        const python_model::values vals = pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
         py::gil_scoped_release release;
         node_buffer rep{};
         tls_guard g(&rep);
-        rep.w = nodes.w.data();
+        rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
+        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
+        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
         rep.capacity = nodes.n;
         for (std::size_t k = 0; k < rows.size(); ++k) {
             rep.alpha = alpha[k];
@@ -421,16 +483,68 @@ py::array_t<float> dfg_lut(long long size, py::object model, const std::string& 
 
 // ---- Monte Carlo DFG and the multiscatter energy terms (built-in models) ----------------------------
 
-builtin builtin_only(const char* fn, py::object model) {
-    const model_arg ma = parse_model(fn, model);
-    if (!ma.is_builtin)
-        throw py::type_error(std::string("ibl.") + fn + ": model must be a built-in model name (" + builtin_names +
-                             "); Python models are taken by ibl.dfg and ibl.dfg_lut");
-    return ma.b;
+
+/// dfg_mc / dfg_mc_vndf of a Python model in T (the built-in path's precision): both estimators call
+/// Model::sample_weight once per draw, in draw order, whatever the values; so the record / replay
+/// passes of the file header apply, per batch of whole points (samples nodes each).
+template <class T>
+std::vector<T> python_dfg_mc(const py::object& obj, const double* mu, const double* r, std::size_t count, std::uint32_t samples,
+                             bool vndf) {
+    std::vector<T> ab(2 * count);
+    const python_model pm(obj);
+    const std::size_t evals = samples;
+    const std::size_t per_batch = std::max<std::size_t>(1, max_batch_nodes / evals);
+    batch_nodes nodes(std::min(count, per_batch) * evals);
+    auto run = [&](auto model_tag, std::size_t i) {
+        using M = decltype(model_tag);
+        return vndf ? ibl::dfg_mc_vndf<M>(T(mu[i]), T(r[i]), samples) : ibl::dfg_mc<M>(T(mu[i]), T(r[i]), samples);
+    };
+    for (std::size_t begin = 0; begin < count; begin += per_batch) {
+        const std::size_t end = std::min(count, begin + per_batch), m = end - begin;
+        std::vector<double> rb(m);
+        for (std::size_t i = 0; i < m; ++i) rb[i] = double(T(r[begin + i])); // the roughness the estimator sees
+        const std::vector<double> alpha = pm.alpha(rb);
+        nodes.use(m * evals);
+        node_buffer buf{};
+        {
+            py::gil_scoped_release release;
+            tls_guard g(&buf);
+            buf.nv = nodes.data[0];
+            buf.nl = nodes.data[1];
+            buf.nh = nodes.data[2];
+            buf.vh = nodes.data[3];
+            buf.capacity = nodes.n;
+            for (std::size_t i = 0; i < m; ++i) {
+                buf.alpha = alpha[i];
+                run(recording_model{}, begin + i);
+                if (buf.cursor != (i + 1) * evals) throw std::logic_error("ibl.dfg_mc: the estimator's call count changed");
+                std::fill(nodes.data[4] + i * evals, nodes.data[4] + (i + 1) * evals, rb[i]);
+                std::fill(nodes.data[5] + i * evals, nodes.data[5] + (i + 1) * evals, alpha[i]);
+            }
+        }
+        if (buf.cursor != nodes.n) throw std::logic_error("ibl.dfg_mc: the estimator's call count changed");
+        const python_model::values vals =
+            pm.evaluate(nodes.n, nodes.view[0], nodes.view[1], nodes.view[2], nodes.view[3], nodes.view[4], nodes.view[5]);
+        py::gil_scoped_release release;
+        node_buffer rep{};
+        tls_guard g(&rep);
+        rep.s = pm.has_sample_weight ? vals.s.data() : nullptr;
+        rep.d = pm.has_sample_weight ? nullptr : vals.d.data();
+        rep.v = pm.has_sample_weight ? nullptr : vals.v.data();
+        rep.capacity = nodes.n;
+        for (std::size_t i = 0; i < m; ++i) {
+            rep.alpha = alpha[i];
+            rep.cursor = i * evals;
+            const ibl::vec2<T> v = run(replay_model{}, begin + i);
+            ab[2 * (begin + i)] = v.x;
+            ab[2 * (begin + i) + 1] = v.y;
+        }
+    }
+    return ab;
 }
 
 py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, py::object model, const std::string& sampling) {
-    const builtin b = builtin_only("dfg_mc", model);
+    const model_arg ma = parse_model("dfg_mc", model);
     if (samples < 1 || samples > (long long)ibl::limits::max_samples)
         throw py::value_error("ibl.dfg_mc: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) + "], got " +
                               std::to_string(samples));
@@ -439,6 +553,19 @@ py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, p
     else if (sampling == "vndf") vndf = true;
     else throw py::value_error("ibl.dfg_mc: sampling must be 'ndf' or 'vndf', got '" + sampling + "'");
     const auto n = std::uint32_t(samples);
+    if (!ma.is_builtin) {
+        const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
+        broadcast_args<double> b = broadcast<double>("dfg_mc", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}});
+        auto emit = [&](auto tag) -> py::object {
+            using T = decltype(tag);
+            const std::vector<T> ab = python_dfg_mc<T>(ma.obj, b.data[0], b.data[1], b.count, n, vndf);
+            py::array_t<T> out = make_output<T>(b.shape, 2);
+            std::copy(ab.begin(), ab.end(), out.mutable_data());
+            return out;
+        };
+        return f32 ? emit(float{}) : emit(double{});
+    }
+    const builtin b = ma.b;
     return map("dfg_mc", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 2, [&](auto tag) {
         using T = decltype(tag);
         return [b, n, vndf](const T* const* in, T* out) {
@@ -453,7 +580,21 @@ py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, p
 }
 
 py::object dfg_albedo(py::object n_dot_v, py::object roughness, py::object model) {
-    const builtin b = builtin_only("dfg_albedo", model);
+    const model_arg ma = parse_model("dfg_albedo", model);
+    if (!ma.is_builtin) { // E of the kernel, as ibl::dfg_albedo takes it (dfg_exact_abe's e)
+        const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
+        broadcast_args<double> b = broadcast<double>("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}});
+        const std::vector<double> eb = python_dfg_eb(ma.obj, b.data[0], b.data[1], b.count);
+        if (b.scalar) return py::float_(f32 ? double(float(eb[0])) : eb[0]);
+        auto emit = [&](auto tag) -> py::object {
+            using T = decltype(tag);
+            py::array_t<T> out = make_output<T>(b.shape, 1);
+            for (std::size_t i = 0; i < b.count; ++i) out.mutable_data()[i] = T(eb[2 * i]);
+            return out;
+        };
+        return f32 ? emit(float{}) : emit(double{});
+    }
+    const builtin b = ma.b;
     return map("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}}, 1, [&](auto tag) {
         using T = decltype(tag);
         return [b](const T* const* in, T* out) {
@@ -517,11 +658,11 @@ void bind_dfg(py::module_& m) {
           "Split-sum DFG terms (A, B) by Monte Carlo with `samples` Hammersley points: array (..., 2) over the\n"
           "broadcast shape of n_dot_v and roughness (in [0, 1]). sampling 'ndf': GGX NDF importance sampling\n"
           "(ibl::dfg_mc, the estimator of Karis 2013); 'vndf': visible normals (ibl::dfg_mc_vndf, Heitz /\n"
-          "Dupuy). Samples below the horizon count as zeros. Built-in models only.");
+          "Dupuy). Samples below the horizon count as zeros. model: as ibl.dfg.");
     m.def("dfg_albedo", &dfg_albedo, py::arg("n_dot_v"), py::arg("roughness"), py::arg("model") = "ggx_height_correlated",
-          "The directional albedo E = A + B of a built-in model by the deterministic quadrature\n"
-          "(ibl::dfg_albedo, bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what\n"
-          "multiple scattering restores.");
+          "The directional albedo E = A + B by the deterministic quadrature (ibl::dfg_albedo,\n"
+          "bake/dfg_multiscatter.hpp): the single-scattering energy; 1 - E is what multiple scattering\n"
+          "restores. model: as ibl.dfg (a built-in name or a Python model object).");
     m.def(
         "dfg_energy_compensation",
         [](py::object albedo) {
@@ -533,6 +674,8 @@ void bind_dfg(py::module_& m) {
         py::arg("albedo"),
         "Turquin's energy compensation k = (1 - E) / E of an albedo E in [0, 1] (E floored at the smallest\n"
         "normal float): the third channel of dfg_lut(multiscatter=True).");
+    
+    m.attr("model_batch_nodes") = py::int_(max_batch_nodes);
     m.attr("builtin_models") = py::make_tuple("ggx_height_correlated", "ggx_schlick_ibl", "blinn_phong");
 }
 

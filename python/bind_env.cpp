@@ -1,8 +1,11 @@
 // python/bind_env.cpp — cube maps in and out: the prefiltered specular chain, the irradiance map,
-// SH projection / evaluation / Lambert convolution and the reference LD. A cube is a float32 array
+// SH projection / evaluation / Lambert convolution and the reference LD (the prefilter and the
+// reference LD with the built-in GGX lobe or the tabulated lobe of a Python model,
+// tabulated_lobe.hpp). A cube is a float32 array
 // (6, n, n, 3): faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x] = texel (x, y) of the library's
 // convention (env/cube_geometry.hpp: row 0 is t = 0, column 0 is s = 0).
 #include "common.hpp"
+#include "tabulated_lobe.hpp"
 
 #include <ibl/bake/irradiance.hpp>
 #include <ibl/bake/prefilter.hpp>
@@ -15,6 +18,7 @@
 #include <ibl/reference/radiance.hpp>
 #include <ibl/sh.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <stdexcept>
@@ -110,8 +114,91 @@ template <int B> py::array_t<double> from_coeffs(const ibl::sh_coeffs<double, B>
     return out;
 }
 
+// ---- the LD lobe of a Python model (tabulated_lobe.hpp) ---------------------------------------------
+
+/// At most this many distinct roughness values per call with a Python model (a table each).
+constexpr std::size_t max_lobe_tables = 1024;
+
+/// A model argument: None or "ggx" is the built-in GGX lobe (false), else a Python model (true).
+bool is_python_lobe(const char* fn, const py::object& model) {
+    if (model.is_none()) return false;
+    if (py::isinstance<py::str>(model)) {
+        if (model.cast<std::string>() == "ggx" || model.cast<std::string>() == "ggx_height_correlated") return false;
+        throw py::value_error(std::string("ibl.") + fn + ": model must be 'ggx' (the built-in lobe) or a Python model "
+                              "object with alpha(roughness) and ndf(n_dot_h, alpha), got '" + model.cast<std::string>() + "'");
+    }
+    for (const char* f : {"alpha", "ndf"})
+        if (!py::hasattr(model, f) || !PyCallable_Check(model.attr(f).ptr()))
+            throw py::type_error(std::string("ibl.") + fn + ": the model object has no callable '" + f +
+                                 "' (the LD lobe of a Python model needs alpha(roughness) and ndf(n_dot_h, alpha))");
+    return true;
+}
+
+/// `count` float64 values from a model method's result (a scalar or shape (count,)).
+std::vector<double> model_values(const char* fn, const char* method, py::object r, std::size_t count) {
+    auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
+    if (!a) throw py::type_error(std::string("ibl.") + fn + ": model." + method + " returned " +
+                                 std::string(py::str(py::type::of(r))) + ", not a real array");
+    if (a.ndim() == 0) return std::vector<double>(count, *a.data());
+    if (a.ndim() == 1 && std::size_t(a.shape(0)) == count) return std::vector<double>(a.data(), a.data() + count);
+    throw py::value_error(std::string("ibl.") + fn + ": model." + method + " returned shape " +
+                          std::string(py::str(py::tuple(a.attr("shape")))) + " for inputs of shape (" +
+                          std::to_string(count) + ",)");
+}
+
+/// The lobe tables of a Python model for the given roughness values: alpha once for all of them,
+/// ndf once per batch of tables (at most 2^16 nodes a call, like the DFG's batches).
+lobe_tables tabulate_lobe(const char* fn, const py::object& model, std::vector<double> rs) {
+    std::sort(rs.begin(), rs.end());
+    rs.erase(std::unique(rs.begin(), rs.end()), rs.end());
+    if (rs.size() > max_lobe_tables)
+        throw py::value_error(std::string("ibl.") + fn + ": a Python model is tabulated once per distinct roughness; " +
+                              std::to_string(rs.size()) + " distinct values given, at most " +
+                              std::to_string(max_lobe_tables));
+    lobe_tables lt;
+    lt.tables.resize(rs.size());
+    if (rs.empty()) return lt;
+    py::array_t<double> ra(py::ssize_t(rs.size()));
+    std::copy(rs.begin(), rs.end(), ra.mutable_data());
+    const std::vector<double> alpha = model_values(fn, "alpha", model.attr("alpha")(ra), rs.size());
+    for (std::size_t i = 0; i < rs.size(); ++i) {
+        if (!std::isfinite(alpha[i]) || alpha[i] < 0.0)
+            throw py::value_error(std::string("ibl.") + fn + ": model.alpha returned " + std::to_string(alpha[i]) +
+                                  " for roughness " + std::to_string(rs[i]) + " (must be finite and >= 0)");
+        lt.tables[i].set_grid(rs[i], alpha[i]);
+    }
+    constexpr std::size_t nodes = lobe_table::cells + 1;
+    const std::size_t per_batch = std::max<std::size_t>(1, (std::size_t(1) << 16) / nodes);
+    for (std::size_t b0 = 0; b0 < rs.size(); b0 += per_batch) {
+        const std::size_t b1 = std::min(rs.size(), b0 + per_batch), n = (b1 - b0) * nodes;
+        py::array_t<double> nh(static_cast<py::ssize_t>(n)), al(static_cast<py::ssize_t>(n));
+        for (std::size_t i = b0; i < b1; ++i)
+            for (std::size_t k = 0; k < nodes; ++k) {
+                nh.mutable_data()[(i - b0) * nodes + k] = lt.tables[i].node_n_dot_h(k);
+                al.mutable_data()[(i - b0) * nodes + k] = alpha[i];
+            }
+        const std::vector<double> d = model_values(fn, "ndf", model.attr("ndf")(nh, al), n);
+        for (std::size_t i = b0; i < b1; ++i) {
+            const double* di = d.data() + (i - b0) * nodes;
+            for (std::size_t k = 0; k < nodes; ++k)
+                if (!std::isfinite(di[k]) || di[k] < 0.0)
+                    throw py::value_error(std::string("ibl.") + fn + ": model.ndf returned " + std::to_string(di[k]) +
+                                          " at n_dot_h=" + std::to_string(nh.data()[(i - b0) * nodes + k]) +
+                                          ", roughness=" + std::to_string(rs[i]) + " (must be finite and >= 0)");
+            lt.tables[i].set_values(di);
+            const double m = lt.tables[i].mass();
+            if (!(m > 0.0) || !std::isfinite(m))
+                throw py::value_error(std::string("ibl.") + fn + ": model.ndf at roughness " + std::to_string(rs[i]) +
+                                      " integrates to " + std::to_string(m) +
+                                      " over the hemisphere (D cos(theta_h)): must be positive and finite");
+        }
+    }
+    return lt;
+}
+
 py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std::string& method, const std::string& weight,
-                   unsigned threads) {
+                   unsigned threads, py::object model) {
+    const bool py_lobe = is_python_lobe("prefilter", model);
     ibl::prefilter_options opt;
     if (method == "fis") opt.method = ibl::prefilter_method::filtered_importance;
     else if (method == "fast") opt.method = ibl::prefilter_method::fast;
@@ -123,9 +210,21 @@ py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std
     if (levels < -1) throw py::value_error("ibl.prefilter: levels must be -1 (automatic), 0 (full chain) or positive");
     opt.levels = levels;
     opt.samples = samples;
+    if (py_lobe && opt.weight == ibl::ld_weight::g1)
+        throw py::value_error("ibl.prefilter: weight='g1' is the GGX G1 weight, for the built-in lobe only; a Python "
+                              "model's lobe takes weight='n_dot_l'");
     ibl::cubemap<float> env = to_cubemap("prefilter", cube, threads);
     std::optional<ibl::specular_chain> chain;
-    {
+    if (py_lobe) {
+        // the roughness of every level the plan convolves (level 0 is the mirror copy)
+        std::vector<double> rs;
+        for (const ibl::prefilter_level& lp : ibl::prefilter_plan<python_lobe>(opt, env.size(0)))
+            if (lp.level > 0) rs.push_back(lp.roughness);
+        const lobe_tables lt = tabulate_lobe("prefilter", model, rs);
+        py::gil_scoped_release release;
+        lobe_tables_scope scope(lt);
+        chain.emplace(ibl::prefilter<python_lobe>(env, opt, ibl::thread_executor{threads}));
+    } else {
         py::gil_scoped_release release;
         chain.emplace(ibl::prefilter(env, opt, ibl::thread_executor{threads}));
     }
@@ -192,12 +291,16 @@ py::array_t<double> sh_irradiance(py::object coeffs) {
 }
 
 py::object reference_ld(py::object cube, py::object dirs, py::object roughness, std::uint32_t samples, const std::string& weight,
-                        unsigned threads) {
+                        unsigned threads, py::object model) {
+    const bool py_lobe = is_python_lobe("reference_ld", model);
     ibl::ld_weight w;
     if (weight == "n_dot_l") w = ibl::ld_weight::n_dot_l;
     else if (weight == "g1") w = ibl::ld_weight::g1;
     else throw py::value_error("ibl.reference_ld: weight must be 'n_dot_l' or 'g1', got '" + weight + "'");
     if (samples > ibl::limits::max_samples) throw py::value_error("ibl.reference_ld: samples above limits::max_samples");
+    if (py_lobe && w == ibl::ld_weight::g1)
+        throw py::value_error("ibl.reference_ld: weight='g1' is the GGX G1 weight, for the built-in lobe only; a Python "
+                              "model's lobe takes weight='n_dot_l'");
     const ibl::cubemap<float> env = to_cubemap("reference_ld", cube, threads);
     broadcast_args<double> b = broadcast<double>("reference_ld", {{dirs, 3, "dirs"}, {roughness, 1, "roughness", true}});
     py::array_t<double> out = make_output<double>(b.shape, 3);
@@ -207,17 +310,26 @@ py::object reference_ld(py::object cube, py::object dirs, py::object roughness, 
     for (std::size_t i = 0; i < b.count; ++i)
         if (!(d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] + d[3 * i + 2] * d[3 * i + 2] > 0.0))
             throw py::value_error("ibl.reference_ld: dirs must be non-zero finite vectors");
-    {
-        py::gil_scoped_release release;
+    auto run = [&](auto lobe_tag) {
+        using Lobe = decltype(lobe_tag);
         ibl::thread_executor{threads}(b.count, [&](std::size_t begin, std::size_t end) {
             for (std::size_t i = begin; i < end; ++i) {
                 const ibl::vec3<double> v =
-                    ibl::reference_ld(env, ibl::vec3<double>(d[3 * i], d[3 * i + 1], d[3 * i + 2]), r[i], samples, w);
+                    ibl::reference_ld<Lobe>(env, ibl::vec3<double>(d[3 * i], d[3 * i + 1], d[3 * i + 2]), r[i], samples, w);
                 o[3 * i] = v.x;
                 o[3 * i + 1] = v.y;
                 o[3 * i + 2] = v.z;
             }
         });
+    };
+    if (py_lobe) {
+        const lobe_tables lt = tabulate_lobe("reference_ld", model, std::vector<double>(r, r + b.count));
+        py::gil_scoped_release release;
+        lobe_tables_scope scope(lt);
+        run(python_lobe{});
+    } else {
+        py::gil_scoped_release release;
+        run(ibl::ggx_lobe{});
     }
     return out;
 }
@@ -264,10 +376,90 @@ py::object extract_sun(py::object cube, double threshold_over_median, double thr
     return py::make_tuple(light, level_array(env, 0));
 }
 
+// ---- reference_radiance of a Python model: record / replay ------------------------------------------
+//
+// reference_radiance<Model> evaluates the model through brdf_lobe<Model>::eval: one Model::ndf and
+// then one Model::visibility call per lobe evaluation, whose number and order depend only on the
+// draws and their densities (GGX VNDF sampling with Model::alpha, the cosine lobe, the environment
+// distribution), never on the values returned. So, as the DFG of a Python model does, each point
+// runs twice: with rr_record_model, which stores the arguments of every call (returning 1), then,
+// after the Python ndf and visibility ran on those arrays (once per batch of points), with
+// rr_replay_model, which returns the model's values in the same order. The estimate, its batches,
+// MIS weights and error are the library's code; nothing of the estimator is restated.
+
+struct rr_buffer {
+    double alpha = 0.0;                  // the model's alpha for the point's roughness
+    double *nh = nullptr, *nv = nullptr, *nl = nullptr; // record: the point's slots
+    const double *d = nullptr, *v = nullptr;            // replay: the model's values
+    std::size_t n_ndf = 0, n_vis = 0, capacity = 0;
+};
+thread_local rr_buffer* tls_rr = nullptr;
+
+struct rr_record_model {
+    static constexpr const char* name = "python";
+    template <class T> static T alpha(T) noexcept { return T(tls_rr->alpha); }
+    template <class T> static T ndf(T n_dot_h, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        if (b.n_ndf < b.capacity) b.nh[b.n_ndf] = double(n_dot_h);
+        ++b.n_ndf;
+        return T(1);
+    }
+    template <class T> static T visibility(T n_dot_v, T n_dot_l, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        if (b.n_vis < b.capacity) {
+            b.nv[b.n_vis] = double(n_dot_v);
+            b.nl[b.n_vis] = double(n_dot_l);
+        }
+        ++b.n_vis;
+        return T(1);
+    }
+    template <class T> static T sample_weight(T, T, T, T, T) noexcept { return T(0); } // not used by brdf_lobe
+};
+struct rr_replay_model {
+    static constexpr const char* name = "python";
+    template <class T> static T alpha(T) noexcept { return T(tls_rr->alpha); }
+    template <class T> static T ndf(T, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        const std::size_t i = b.n_ndf++;
+        return i < b.capacity ? T(b.d[i]) : T(0);
+    }
+    template <class T> static T visibility(T, T, T) noexcept {
+        rr_buffer& b = *tls_rr;
+        const std::size_t i = b.n_vis++;
+        return i < b.capacity ? T(b.v[i]) : T(0);
+    }
+    template <class T> static T sample_weight(T, T, T, T, T) noexcept { return T(0); }
+};
+static_assert(ibl::brdf_model<rr_record_model, double> && ibl::brdf_model<rr_replay_model, double>);
+
+struct rr_tls_guard {
+    explicit rr_tls_guard(rr_buffer* b) { tls_rr = b; }
+    ~rr_tls_guard() { tls_rr = nullptr; }
+    rr_tls_guard(const rr_tls_guard&) = delete;
+    rr_tls_guard& operator=(const rr_tls_guard&) = delete;
+};
+
 py::dict reference_radiance(py::object cube, py::object n, py::object v, py::object base_color, py::object metallic,
                             py::object roughness, long long samples, long long batches, std::uint32_t seed,
-                            const std::string& strategy, const std::string& diffuse, double dielectric_f0, unsigned threads) {
+                            const std::string& strategy, const std::string& diffuse, double dielectric_f0, unsigned threads,
+                            py::object model) {
     const char* fn = "reference_radiance";
+    bool py_model = false;
+    if (!model.is_none()) {
+        if (py::isinstance<py::str>(model)) {
+            const std::string name = model.cast<std::string>();
+            if (name != "ggx" && name != "ggx_height_correlated")
+                throw py::value_error("ibl.reference_radiance: model must be 'ggx_height_correlated' (alias 'ggx') or a "
+                                      "Python model object with alpha, ndf and visibility, got '" + name + "'");
+        } else {
+            py_model = true;
+            for (const char* f : {"alpha", "ndf", "visibility"})
+                if (!py::hasattr(model, f) || !PyCallable_Check(model.attr(f).ptr()))
+                    throw py::type_error(std::string("ibl.reference_radiance: the model object has no callable '") + f +
+                                         "' (needs alpha(roughness), ndf(n_dot_h, alpha), visibility(n_dot_v, n_dot_l, "
+                                         "roughness))");
+        }
+    }
     ibl::radiance_reference_options opt;
     if (samples < 1 || samples > (long long)ibl::limits::max_samples)
         throw py::value_error("ibl.reference_radiance: samples must lie in [1, " + std::to_string(ibl::limits::max_samples) +
@@ -305,24 +497,120 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
     const ibl::cubemap<float> env = to_cubemap(fn, cube, threads);
     std::optional<ibl::cube_env_distribution> dist;
     std::vector<double> out(b.count * 12);
+    auto material = [&](std::size_t i) {
+        const double* c = b.data[2] + 3 * i;
+        return ibl::make_reference_material(ibl::vec3<double>(c[0], c[1], c[2]), b.data[3][i], b.data[4][i], dw, dielectric_f0);
+    };
+    auto store = [&](std::size_t i, const ibl::radiance_estimate& e) {
+        const ibl::vec3<double>* parts[4] = {&e.value, &e.diffuse, &e.specular, &e.std_error};
+        for (int p = 0; p < 4; ++p)
+            for (int c = 0; c < 3; ++c) out[(std::size_t(p) * b.count + i) * 3 + std::size_t(c)] = (*parts[p])[c];
+    };
+    auto point = [&](auto model_tag, std::size_t i) {
+        using M = decltype(model_tag);
+        auto vec = [&](int k) {
+            const double* d = b.data[std::size_t(k)] + 3 * i;
+            return ibl::vec3<double>(d[0], d[1], d[2]);
+        };
+        return ibl::reference_radiance<M>(env, dist ? &*dist : nullptr, glm::normalize(vec(0)), glm::normalize(vec(1)),
+                                          material(i), opt);
+    };
     {
         py::gil_scoped_release release;
         if (opt.strategy != ibl::radiance_strategy::brdf) dist.emplace(env);
+    }
+    if (!py_model) {
+        py::gil_scoped_release release;
         ibl::thread_executor{threads}(b.count, [&](std::size_t begin, std::size_t end) {
-            for (std::size_t i = begin; i < end; ++i) {
-                auto vec = [&](int k) {
-                    const double* d = b.data[std::size_t(k)] + 3 * i;
-                    return ibl::vec3<double>(d[0], d[1], d[2]);
-                };
-                const ibl::reference_material mat =
-                    ibl::make_reference_material(vec(2), b.data[3][i], b.data[4][i], dw, dielectric_f0);
-                const ibl::radiance_estimate e = ibl::reference_radiance(env, dist ? &*dist : nullptr, glm::normalize(vec(0)),
-                                                                         glm::normalize(vec(1)), mat, opt);
-                const ibl::vec3<double>* parts[4] = {&e.value, &e.diffuse, &e.specular, &e.std_error};
-                for (int p = 0; p < 4; ++p)
-                    for (int c = 0; c < 3; ++c) out[(std::size_t(p) * b.count + i) * 3 + std::size_t(c)] = (*parts[p])[c];
-            }
+            for (std::size_t i = begin; i < end; ++i) store(i, point(ibl::ggx_height_correlated{}, i));
         });
+    } else {
+        // at most samples lobe evaluations per point (one per draw); points in batches of <= 2^16 slots
+        const std::size_t cap = std::size_t(opt.samples);
+        const std::size_t per_batch = std::max<std::size_t>(1, (std::size_t(1) << 16) / cap);
+        for (std::size_t p0 = 0; p0 < b.count; p0 += per_batch) {
+            const std::size_t p1 = std::min(b.count, p0 + per_batch), m = p1 - p0;
+            py::array_t<double> rough(static_cast<py::ssize_t>(m));
+            for (std::size_t i = 0; i < m; ++i) rough.mutable_data()[i] = material(p0 + i).roughness;
+            py::array_t<double> alpha_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
+                model.attr("alpha")(rough));
+            if (!alpha_arr || !(alpha_arr.ndim() == 0 || (alpha_arr.ndim() == 1 && std::size_t(alpha_arr.shape(0)) == m)))
+                throw py::value_error("ibl.reference_radiance: model.alpha must return a real scalar or an array of shape (" +
+                                      std::to_string(m) + ",)");
+            std::vector<rr_buffer> bufs(m);
+            std::vector<double> nh(m * cap), nv(m * cap), nl(m * cap);
+            for (std::size_t i = 0; i < m; ++i) {
+                const double a = alpha_arr.ndim() == 0 ? *alpha_arr.data() : alpha_arr.data()[i];
+                if (!std::isfinite(a) || a < 0.0)
+                    throw py::value_error("ibl.reference_radiance: model.alpha returned " + std::to_string(a) +
+                                          " for roughness " + std::to_string(rough.data()[i]) + " (must be finite and >= 0)");
+                bufs[i].alpha = a;
+                bufs[i].nh = nh.data() + i * cap;
+                bufs[i].nv = nv.data() + i * cap;
+                bufs[i].nl = nl.data() + i * cap;
+                bufs[i].capacity = cap;
+            }
+            {
+                py::gil_scoped_release release;
+                ibl::thread_executor{threads}(m, [&](std::size_t begin, std::size_t end) {
+                    for (std::size_t i = begin; i < end; ++i) {
+                        rr_tls_guard g(&bufs[i]);
+                        point(rr_record_model{}, p0 + i);
+                    }
+                });
+            }
+            // the recorded calls of the batch, packed: point i's first count_i slots
+            std::size_t total = 0;
+            for (const rr_buffer& rb : bufs) {
+                if (rb.n_ndf != rb.n_vis || rb.n_ndf > cap)
+                    throw std::logic_error("ibl.reference_radiance: unexpected model call pattern");
+                total += rb.n_ndf;
+            }
+            py::array_t<double> a_nh(static_cast<py::ssize_t>(total)), a_al(static_cast<py::ssize_t>(total)),
+                a_nv(static_cast<py::ssize_t>(total)), a_nl(static_cast<py::ssize_t>(total)), a_r(static_cast<py::ssize_t>(total));
+            std::vector<std::size_t> offset(m);
+            for (std::size_t i = 0, at = 0; i < m; ++i) {
+                offset[i] = at;
+                for (std::size_t k = 0; k < bufs[i].n_ndf; ++k, ++at) {
+                    a_nh.mutable_data()[at] = bufs[i].nh[k];
+                    a_al.mutable_data()[at] = bufs[i].alpha;
+                    a_nv.mutable_data()[at] = bufs[i].nv[k];
+                    a_nl.mutable_data()[at] = bufs[i].nl[k];
+                    a_r.mutable_data()[at] = rough.data()[i];
+                }
+            }
+            auto values = [&](py::object r, const char* fn_name) {
+                auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
+                if (!a || !(a.ndim() == 0 || (a.ndim() == 1 && std::size_t(a.shape(0)) == total)))
+                    throw py::value_error(std::string("ibl.reference_radiance: model.") + fn_name +
+                                          " must return a real scalar or an array of shape (" + std::to_string(total) + ",)");
+                std::vector<double> vals(total);
+                for (std::size_t k = 0; k < total; ++k) {
+                    vals[k] = a.ndim() == 0 ? *a.data() : a.data()[k];
+                    if (!std::isfinite(vals[k]))
+                        throw py::value_error(std::string("ibl.reference_radiance: model.") + fn_name + " returned " +
+                                              std::to_string(vals[k]) + " at n_dot_v=" + std::to_string(a_nv.data()[k]) +
+                                              ", n_dot_l=" + std::to_string(a_nl.data()[k]) + ", n_dot_h=" +
+                                              std::to_string(a_nh.data()[k]) + ", roughness=" + std::to_string(a_r.data()[k]) +
+                                              " (must be finite)");
+                }
+                return vals;
+            };
+            const std::vector<double> dv = values(model.attr("ndf")(a_nh, a_al), "ndf");
+            const std::vector<double> vv = values(model.attr("visibility")(a_nv, a_nl, a_r), "visibility");
+            py::gil_scoped_release release;
+            ibl::thread_executor{threads}(m, [&](std::size_t begin, std::size_t end) {
+                for (std::size_t i = begin; i < end; ++i) {
+                    rr_buffer rep{};
+                    rep.alpha = bufs[i].alpha;
+                    rep.d = dv.data() + offset[i];
+                    rep.v = vv.data() + offset[i];
+                    rep.capacity = bufs[i].n_ndf;
+                    rr_tls_guard g(&rep);
+                    store(p0 + i, point(rr_replay_model{}, p0 + i));
+                }
+            });
+        }
     }
     py::dict result;
     const char* names[4] = {"value", "diffuse", "specular", "std_error"};
@@ -339,13 +627,16 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
 
 void bind_env(py::module_& m) {
     m.def("prefilter", &prefilter, py::arg("cube"), py::kw_only(), py::arg("levels") = -1, py::arg("samples") = 0u,
-          py::arg("method") = "fis", py::arg("weight") = "n_dot_l", py::arg("threads") = 0u,
-          "The prefiltered specular chain of ibl::prefilter (GGX, N = V = R): a list of float32 arrays\n"
+          py::arg("method") = "fis", py::arg("weight") = "n_dot_l", py::arg("threads") = 0u, py::arg("model") = py::none(),
+          "The prefiltered specular chain of ibl::prefilter (N = V = R): a list of float32 arrays\n"
           "(6, s, s, 3), level l of face size max(1, n >> l) for roughness l / (levels - 1).\n"
           "cube: (6, n, n, 3), faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0. levels: -1\n"
           "automatic (ibl-bake's rule), 0 the full chain. samples: per texel at level 1 (0 = the default\n"
           "doubling schedule). method 'fis' (filtered importance sampling), 'fast' or 'importance'.\n"
-          "weight 'n_dot_l' (Karis) or 'g1'. threads: 0 = all cores.");
+          "weight 'n_dot_l' (Karis) or 'g1'. threads: 0 = all cores. model: None or 'ggx' (the built-in\n"
+          "GGX lobe) or a Python model with alpha(roughness) and ndf(n_dot_h, alpha): its LD lobe,\n"
+          "tabulated from one vectorised ndf call on a fine grid of n.h per level roughness\n"
+          "(weight 'n_dot_l' only).");
     m.def("irradiance", &irradiance, py::arg("cube"), py::arg("size") = 32, py::kw_only(), py::arg("samples") = 1024u,
           py::arg("method") = "cosine", py::arg("threads") = 0u,
           "Irradiance cube (6, size, size, 3) float32 of ibl::irradiance_cubemap: E(n) at every texel\n"
@@ -358,9 +649,11 @@ void bind_env(py::module_& m) {
     m.def("sh_irradiance", &sh_irradiance, py::arg("coeffs"),
           "The Lambert convolution of radiance SH: irradiance SH E_lm = A_l L_lm (ibl::sh_irradiance).");
     m.def("reference_ld", &reference_ld, py::arg("cube"), py::arg("dirs"), py::arg("roughness"), py::arg("samples") = 4096u,
-          py::kw_only(), py::arg("weight") = "n_dot_l", py::arg("threads") = 0u,
-          "Converged LD at directions (..., 3) and roughness (broadcast) by GGX importance sampling of the\n"
-          "cube's level 0 (ibl::reference_ld, double): array (..., 3).");
+          py::kw_only(), py::arg("weight") = "n_dot_l", py::arg("threads") = 0u, py::arg("model") = py::none(),
+          "Converged LD at directions (..., 3) and roughness (broadcast) by importance sampling of the\n"
+          "cube's level 0 (ibl::reference_ld, double): array (..., 3). model: None or 'ggx' (the built-in\n"
+          "GGX lobe) or a Python model (alpha, ndf): its tabulated LD lobe as in ibl.prefilter, one\n"
+          "table per distinct roughness (at most 1024).");
     m.def("extract_sun", &extract_sun, py::arg("cube"), py::kw_only(), py::arg("threshold_over_median") = 50.0,
           py::arg("threshold_over_peak") = 1e-3, py::arg("max_solid_angle") = 1e-2, py::arg("min_share") = 0.2,
           py::arg("threads") = 0u,
@@ -375,7 +668,7 @@ void bind_env(py::module_& m) {
     m.def("reference_radiance", &reference_radiance, py::arg("cube"), py::arg("n"), py::arg("v"), py::arg("base_color"),
           py::arg("metallic"), py::arg("roughness"), py::kw_only(), py::arg("samples") = 4096, py::arg("batches") = 16,
           py::arg("seed") = 0u, py::arg("strategy") = "mis", py::arg("diffuse") = "lambert", py::arg("dielectric_f0") = 0.04,
-          py::arg("threads") = 0u,
+          py::arg("threads") = 0u, py::arg("model") = py::none(),
           "Outgoing radiance Lo(n, v) of a metallic-roughness material under the cube WITHOUT the split sum\n"
           "(ibl::reference_radiance, reference/radiance.hpp: GGX height-correlated specular + Lambert, single\n"
           "scattering, F90 = 1), by multiple importance sampling of the BRDF and the environment (randomised\n"
@@ -383,7 +676,10 @@ void bind_env(py::module_& m) {
           "(normalised here), base_color (..., 3), metallic, roughness broadcast; all in [0, 1] but n, v.\n"
           "strategy 'mis', 'brdf' or 'env'; diffuse 'lambert' (k_d = 1) or 'one_minus_fresnel_roughness' (the\n"
           "single-scattering shader's kD). Returns a dict of float64 arrays (..., 3): 'value', 'diffuse',\n"
-          "'specular' and 'std_error' (of value, from the batch means). Deterministic for given inputs.");
+          "'specular' and 'std_error' (of value, from the batch means). Deterministic for given inputs.\n"
+          "model: None or 'ggx' (GGX height-correlated), or a Python model with alpha(roughness),\n"
+          "ndf(n_dot_h, alpha), visibility(n_dot_v, n_dot_l, roughness): the same estimator run twice per\n"
+          "batch of points (record the calls, evaluate the model once per batch, replay its values).");
 }
 
 } // namespace ibl_py

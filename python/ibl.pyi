@@ -13,10 +13,12 @@ Real = Union[float, np.ndarray]
 
 __version__: str
 builtin_models: tuple[str, ...]
+model_batch_nodes: int  # the most nodes a Python model's methods see in one call (2^16)
 
 class BRDFModel(Protocol):
     """A Python BRDF model (brdf/model.hpp's contract). Every method receives float64 arrays of
-    equal shape (one batch of quadrature nodes) and returns an array of that shape (or a scalar).
+    equal shape (one batch of quadrature nodes, at most model_batch_nodes long) and returns an
+    array of that shape (or a scalar).
     Either ndf + visibility (the weight 4 V n.l (v.h) / n.h * D / D_ggx is formed by the binding) or
     sample_weight must be present."""
     def alpha(self, roughness: np.ndarray) -> np.ndarray: ...
@@ -62,28 +64,44 @@ def dfg_lut(size: int, model: Model = "ggx_height_correlated", *, layout: str = 
             multiscatter: bool = False, threads: int = 0) -> np.ndarray: ...  # float32 (size, size, 2 or 3)
 def dfg_smooth_limit(n_dot_v: ArrayLike) -> np.ndarray: ...  # (..., 2)
 def dfg_lut_coords(size: int, layout: str = "uniform") -> tuple[np.ndarray, np.ndarray]: ...  # (n_dot_v, roughness)
-def dfg_mc(n_dot_v: ArrayLike, roughness: ArrayLike, samples: int = 1024, model: str = "ggx_height_correlated", *,
-           sampling: str = "ndf") -> np.ndarray: ...  # (..., 2); sampling "ndf" | "vndf"; built-in models only
-def dfg_albedo(n_dot_v: ArrayLike, roughness: ArrayLike, model: str = "ggx_height_correlated") -> Real: ...  # E = A + B
+def dfg_mc(n_dot_v: ArrayLike, roughness: ArrayLike, samples: int = 1024, model: Model = "ggx_height_correlated", *,
+           sampling: str = "ndf") -> np.ndarray: ...  # (..., 2); sampling "ndf" | "vndf"
+def dfg_albedo(n_dot_v: ArrayLike, roughness: ArrayLike, model: Model = "ggx_height_correlated") -> Real: ...  # E = A + B
 def dfg_energy_compensation(albedo: ArrayLike) -> Real: ...  # (1 - E) / E
 
 # ---- cubes: (6, n, n, 3) float32, faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0 ----
+class LobeModel(Protocol):
+    """What prefilter and reference_ld use of a Python model: alpha and an isotropic ndf. The LD
+    lobe D(h) n.l (N = V = R) is tabulated per roughness from one vectorised ndf call on 4097 n.h
+    nodes (python/tabulated_lobe.hpp: y = ln(1 + tan^2(theta_h) / alpha^2) on a uniform grid,
+    D cos^4 e^y interpolated exponentially, exact for GGX), sampled by the inverse CDF of the
+    table; a model restating GGX gives the built-in GGX results to float rounding."""
+    def alpha(self, roughness: np.ndarray) -> np.ndarray: ...
+    def ndf(self, n_dot_h: np.ndarray, alpha: np.ndarray) -> np.ndarray: ...
+
+LobeArg = Union[None, str, LobeModel]  # None or "ggx": the built-in GGX lobe
+
 def prefilter(cube: ArrayLike, *, levels: int = -1, samples: int = 0, method: str = "fis",
-              weight: str = "n_dot_l", threads: int = 0) -> list[np.ndarray]: ...
+              weight: str = "n_dot_l", threads: int = 0,
+              model: LobeArg = None) -> list[np.ndarray]: ...  # a Python model: weight "n_dot_l" only
 def irradiance(cube: ArrayLike, size: int = 32, *, samples: int = 1024, method: str = "cosine",
                threads: int = 0) -> np.ndarray: ...
 def sh_project(cube: ArrayLike, bands: int = 3, *, threads: int = 0) -> np.ndarray: ...  # (bands^2, 3)
 def sh_evaluate(coeffs: ArrayLike, dirs: ArrayLike) -> np.ndarray: ...  # (..., 3)
 def sh_irradiance(coeffs: ArrayLike) -> np.ndarray: ...  # (bands^2, 3)
 def reference_ld(cube: ArrayLike, dirs: ArrayLike, roughness: ArrayLike, samples: int = 4096, *,
-                 weight: str = "n_dot_l", threads: int = 0) -> np.ndarray: ...  # (..., 3)
+                 weight: str = "n_dot_l", threads: int = 0,
+                 model: LobeArg = None) -> np.ndarray: ...  # (..., 3); a Python model: <= 1024 distinct roughness
 def extract_sun(cube: ArrayLike, *, threshold_over_median: float = 50.0, threshold_over_peak: float = 1e-3,
                 max_solid_angle: float = 1e-2, min_share: float = 0.2,
                 threads: int = 0) -> Optional[tuple[dict[str, Any], np.ndarray]]: ...  # (light, residual cube) or None
 def reference_radiance(cube: ArrayLike, n: ArrayLike, v: ArrayLike, base_color: ArrayLike, metallic: ArrayLike,
                        roughness: ArrayLike, *, samples: int = 4096, batches: int = 16, seed: int = 0,
                        strategy: str = "mis", diffuse: str = "lambert", dielectric_f0: float = 0.04,
-                       threads: int = 0) -> dict[str, np.ndarray]: ...  # value, diffuse, specular, std_error: (..., 3)
+                       threads: int = 0, model: Union[None, str, BRDFModel] = None
+                       ) -> dict[str, np.ndarray]: ...  # value, diffuse, specular, std_error: (..., 3)
+# reference_radiance model: None / "ggx" (GGX height-correlated) or a Python model with alpha, ndf and
+# visibility (sample_weight is not used), evaluated once per batch of points on the recorded calls
 
 # ---- files (the bake tool's I/O library; has_image_io False: RuntimeError) ----
 has_image_io: bool

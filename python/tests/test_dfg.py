@@ -79,23 +79,48 @@ def test_python_sample_weight_model():
 
 
 def test_python_model_called_once_per_batch():
-    counts = {"alpha": 0, "ndf": 0, "visibility": 0}
+    calls = {"alpha": [], "ndf": [], "visibility": []}  # the length of each call's arrays
 
     class Counting(GGXHeightCorrelated):
         def alpha(self, r):
-            counts["alpha"] += 1
+            calls["alpha"].append(np.size(r))
             return super().alpha(r)
 
         def ndf(self, n_dot_h, a):
-            counts["ndf"] += 1
+            calls["ndf"].append(n_dot_h.size)
             return super().ndf(n_dot_h, a)
 
         def visibility(self, n_dot_v, n_dot_l, r):
-            counts["visibility"] += 1
+            calls["visibility"].append(n_dot_v.size)
             return v_ggx_correlated(n_dot_v, n_dot_l, np.clip(r, 0.0, 1.0) ** 2)
 
     ibl.dfg_lut(64, Counting())
-    assert counts == {"alpha": 1, "ndf": 1, "visibility": 1}
+    # whole table rows per batch, at most model_batch_nodes nodes: 64 x 432 nodes a row (the table
+    # nodes, dfg_lut_default_nodes), so two rows a batch and 32 batches for the 64 rows
+    row = 64 * 432
+    per_batch = ibl.model_batch_nodes // row
+    assert per_batch >= 1
+    assert calls["ndf"] == calls["visibility"]
+    assert sum(calls["ndf"]) == 64 * row
+    assert all(n <= ibl.model_batch_nodes and n % row == 0 for n in calls["ndf"])
+    assert len(calls["ndf"]) == -(-64 // per_batch) == len(calls["alpha"])
+    assert calls["alpha"] == [n // row for n in calls["ndf"]]  # alpha once per batch, one value a row
+
+
+def test_arrays_kept_by_a_model_stay_as_given():
+    kept = []
+
+    class Keeping(GGXHeightCorrelated):
+        def ndf(self, n_dot_h, a):
+            kept.append((n_dot_h, n_dot_h.copy(), a[::2], a[::2].copy()))  # the array and a NumPy view of one
+            return super().ndf(n_dot_h, a)
+
+    ref = ibl.dfg_lut(64)
+    assert np.abs(ibl.dfg_lut(64, Keeping()).astype(np.float64) - ref).max() < 1e-6
+    assert len(kept) > 2
+    for arr, copy, view, view_copy in kept:  # later batches did not write into what an earlier one was given
+        np.testing.assert_array_equal(arr, copy)
+        np.testing.assert_array_equal(view, view_copy)
 
 
 def test_cost_of_python_model():

@@ -143,3 +143,49 @@ def test_reference_radiance_bad_input():
         ibl.reference_radiance(cube, [0, 0, 0.0], [0, 0, 1.0], np.ones(3), 0.0, 0.5)
     with pytest.raises(ValueError, match="shape"):
         ibl.reference_radiance(np.ones((6, 4, 4, 4), np.float32), *args)
+
+
+def test_reference_radiance_of_python_models():
+    from conftest import BlinnPhong, GGXHeightCorrelated
+    rng = np.random.default_rng(2)
+    cube = (0.2 + rng.random((6, 16, 16, 3))).astype(np.float32)
+    cube[2, 4:6, 4:6] = 40.0
+    n = rng.normal(size=(10, 3))
+    v = n + 0.8 * rng.normal(size=(10, 3))
+    base, metal = rng.random((10, 3)), rng.random(10)
+    r = np.array([0.0, 0.05, 0.3, 0.7, 1.0] * 2)  # with the mirror regime (no model calls)
+    for strategy in ("mis", "brdf", "env"):
+        cpp = ibl.reference_radiance(cube, n, v, base, metal, r, samples=1024, strategy=strategy)
+        py = ibl.reference_radiance(cube, n, v, base, metal, r, samples=1024, strategy=strategy,
+                                    model=GGXHeightCorrelated())
+        for k in cpp:  # the same estimator and draws, the NumPy restatement's values: measured equal
+            np.testing.assert_allclose(py[k], cpp[k], rtol=1e-12, atol=0, err_msg=f"{strategy} {k}")
+    # white furnace of a white metal: Lo = E = A + B of the model (its own dfg_albedo); Blinn-Phong's
+    # E is told apart from GGX's by many standard errors
+    white = np.ones((6, 8, 8, 3), np.float32)
+    nv = np.array([0.2, 0.5, 0.9])
+    views = np.stack([np.sqrt(1 - nv ** 2), 0 * nv, nv], -1)
+    for rough in (0.3, 0.7):
+        e = ibl.reference_radiance(white, [0, 0, 1], views, [1, 1, 1], 1.0, rough, samples=4096, model=BlinnPhong())
+        want = ibl.dfg_albedo(nv, rough, BlinnPhong())
+        assert (np.abs(e["value"][:, 0] - want) < 5 * e["std_error"][:, 0]).all(), rough
+        assert (np.abs(ibl.dfg_albedo(nv, rough) - want) > 10 * e["std_error"][:, 0]).any(), rough
+
+    class NoVisibility:
+        def alpha(self, r):
+            return r * r
+
+        def ndf(self, n_dot_h, a):
+            return 1.0
+
+    with pytest.raises(TypeError, match="visibility"):
+        ibl.reference_radiance(white, [0, 0, 1], [0, 0, 1], [1, 1, 1], 1.0, 0.5, model=NoVisibility())
+
+    class NaNNdf(GGXHeightCorrelated):
+        def ndf(self, n_dot_h, a):
+            return np.full_like(n_dot_h, np.nan)
+
+    with pytest.raises(ValueError, match="ndf returned nan"):
+        ibl.reference_radiance(white, [0, 0, 1], [0, 0, 1], [1, 1, 1], 1.0, 0.5, model=NaNNdf())
+    with pytest.raises(ValueError, match="model must be"):
+        ibl.reference_radiance(white, [0, 0, 1], [0, 0, 1], [1, 1, 1], 1.0, 0.5, model="beckmann")
