@@ -876,15 +876,16 @@ void print_fixtures() {
 }
 
 /// The prefilter test's fixtures (tools/viewer/prefilter.frag.glsl, ibl_prefilter.glsl): the default
-/// sky baked to 32^2, split by the fast filter's peak split (split_cube_peaks; its sun leaves the
-/// tap set's source) and the split's base packed as the C++ kernel reads it (detail::pack_cube, 256
-/// texels per row), and per convolved level of the fast filter's chain (ibl::prefilter, method
-/// fast, default plan, peaks.cut = 0: every peak in front of a row, the GPU's plain sum) its
-/// single-level taps as the kernel runs them (make_ld_table_for + detail::make_taps), its merged
-/// peaks as the row kernel adds them (make_peak_level: direction and pre-scaled energy, a2, the
-/// weight) and the chain's texels (face, row, column) the GLSL must reproduce.
+/// sky baked to 64^2 (level 0 as "source"), split by the fast filter's peak split (split_cube_peaks:
+/// its sun, 4 texels, leaves the tap set's source) and the split's base packed as the C++ kernel
+/// reads it (detail::pack_cube, 256 texels per row), and per LD weight (n.l, g1) and convolved level
+/// of the fast filter's chain (ibl::prefilter, method fast, default plan, peaks.cut = 0: every peak
+/// in front of a row, the GPU's plain sum) its single-level taps as the kernel runs them
+/// (make_ld_table_for + detail::make_taps), its merged peaks as the row kernel adds them
+/// (make_peak_level: direction and pre-scaled energy, a2, the weight; 4 peaks at level 1, merged to
+/// 2 from level 2) and the chain's texels (face, row, column) the GLSL must reproduce.
 void print_prefilter_fixtures() {
-    constexpr int size = 32, width = 256;
+    constexpr int size = 64, width = 256;
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
     ibl::prefilter_options o;
     o.method = ibl::prefilter_method::fast;

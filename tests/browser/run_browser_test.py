@@ -16,10 +16,13 @@ SwiftShader's WebGL2), compared with the C++.
            interactive viewer to --out (docs/shaders-viewer.png); with --page room, the room
            example (room.html) from --reference's JSON instead (docs/local_probes-room.png).
   prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
-           fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 32^2, packed,
-           and the fast filter's taps per level) and compares every texel of every convolved level
-           with the C++ chain (ibl::prefilter, method fast) within half-float rounding: |GLSL - C++|
-           <= 2^-11 |C++| per value.
+           fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 64^2 split by
+           the peak split, its base packed, and per LD weight and level the fast filter's taps and
+           merged peaks) and compares every texel of every convolved level with the C++ chain
+           (ibl::prefilter, method fast, peaks.cut = 0) within half-float rounding: |GLSL - C++|
+           <= 2^-11 |C++| per value. Then the viewer's own inputs (tools/viewer/refilter.js: the
+           split, the base's packing, the taps, the peak lists) against the C++ ones, and the
+           levels rendered from them against the C++ chain (1e-4 relative).
   bc6h     the browser's own BC6H decoder against the library's: the page uploads the blocks that
            `bc6h_fixtures` prints (random blocks of every mode code, reserved ones included, and
            blocks ibl::bc6h_encode_image made of HDR content) as one EXT_texture_compression_bptc
