@@ -57,6 +57,7 @@ void main() {
     float pf_s, pf_t;
     ibl_cube_face_st(u_l, pf_face, pf_s, pf_t);
     vec3 pf = ibl_prefilter_texel(u_taps_a, u_taps_b, u_taps, 1.0, u_n) + ibl_cube_texel_direction(pf_face, 1, 2, 8) +
+              ibl_prefilter_peaks(u_taps_b, u_taps, u_r, u_taps > 2, u_n) +
               ibl_packed_texel(u_taps_a, 3).xyz * (pf_s + pf_t);
     ibl_probe_box pb = ibl_probe_box_axis_aligned(vec3(-2.0), vec3(3.0));
     ibl_parallax_lookup pl = ibl_parallax_box(pb, vec3(0.5), u_n, u_l);

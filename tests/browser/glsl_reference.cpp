@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <ibl/bake/prefilter.hpp>
+#include <ibl/bake/prefilter_peaks.hpp>
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
@@ -875,54 +876,87 @@ void print_fixtures() {
 }
 
 /// The prefilter test's fixtures (tools/viewer/prefilter.frag.glsl, ibl_prefilter.glsl): the default
-/// sky baked to 32^2 and packed as the C++ kernel reads it (detail::pack_cube, 256 texels per
-/// row), and per convolved level of the fast filter's chain (ibl::prefilter, method fast, default
-/// plan) its single-level taps as the kernel runs them (make_ld_table_for + detail::make_taps, what
-/// prefilter builds; the peak split off) and the chain's texels (face, row, column) the GLSL must reproduce.
+/// sky baked to 64^2 (level 0 as "source"), split by the fast filter's peak split (split_cube_peaks:
+/// its sun, 4 texels, leaves the tap set's source) and the split's base packed as the C++ kernel
+/// reads it (detail::pack_cube, 256 texels per row), and per LD weight (n.l, g1) and convolved level
+/// of the fast filter's chain (ibl::prefilter, method fast, default plan, peaks.cut = 0: every peak
+/// in front of a row, the GPU's plain sum) its single-level taps as the kernel runs them
+/// (make_ld_table_for + detail::make_taps), its merged peaks as the row kernel adds them
+/// (make_peak_level: direction and pre-scaled energy, a2, the weight; 4 peaks at level 1, merged to
+/// 2 from level 2) and the chain's texels (face, row, column) the GLSL must reproduce.
 void print_prefilter_fixtures() {
-    constexpr int size = 32, width = 256;
+    constexpr int size = 64, width = 256;
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
     ibl::prefilter_options o;
     o.method = ibl::prefilter_method::fast;
-    o.peaks.enabled = false; // the GLSL filter runs the tap set only (docs/shaders.md)
-    const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
-    const ibl::detail::packed_cube packed = ibl::detail::pack_cube(src);
+    o.peaks.enabled = true;
+    o.peaks.cut = 0.0; // every peak in front of some texel of a row: the GLSL's plain sum over the list
+    // What prefilter's cubemap source holds (detail::prefilter_cube_source): the split's base packed
+    // when there are peaks, else the source.
+    const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(src, o.peaks, ibl::serial_executor{});
+    const ibl::cubemap<float>& base = split.empty() ? src : split.base;
+    const ibl::detail::packed_cube packed = ibl::detail::pack_cube(base);
     const std::size_t texels = packed.data.size() / 4, height = (texels + width - 1) / width;
-    std::printf("{\"width\": %d, \"height\": %zu, \"size\": %d, \"packed\": [", width, height, size);
+    std::printf("{\"width\": %d, \"height\": %zu, \"size\": %d, \"source_peaks\": %zu, \"threshold\": %.17g, "
+                "\"mean_luminance\": %.17g, \"packed\": [",
+                width, height, size, split.peaks.size(), split.threshold, split.mean_luminance);
     for (std::size_t k = 0; k < width * height * 4; ++k)
         std::printf("%s%.9g", k ? ", " : "", k < packed.data.size() ? double(packed.data[k]) : 0.0);
+    std::printf("], \"source\": ["); // level 0 of the source (face, row, column; RGB): the viewer's split reads it
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < size; ++y)
+            for (int x = 0; x < size; ++x) {
+                const ibl::vec3<float> v = src.texel(f, x, y, 0);
+                std::printf("%s%.9g, %.9g, %.9g", f || y || x ? ", " : "", double(v.x), double(v.y), double(v.z));
+            }
     std::printf("], \"levels\": [");
-    const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(o, size);
     bool first = true;
-    for (std::size_t l = 0; l < plan.size(); ++l) {
-        const ibl::prefilter_level& lp = plan[l];
-        if (lp.level == 0) continue; // the mirror level is a copy
-        ibl::sphere_sample_table<float> table =
-            ibl::make_ld_table_for<float>(src, lp.roughness, lp.samples, o.method, o.lod_bias, o.weight);
-        table.trilinear = lp.trilinear;
-        const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
-        const int n = chain.size(int(l));
-        std::printf("%s{\"level\": %d, \"n\": %d, \"roughness\": %.17g, \"samples\": %u, \"trilinear\": %s, \"weight\": \"%s\", "
-                    "\"count\": %zu, \"factor\": %.9g, \"taps\": [",
-                    first ? "" : ", ", int(l), n, lp.roughness, lp.samples, lp.trilinear ? "true" : "false",
-                    o.weight == ibl::ld_weight::g1 ? "g1" : "nl", taps.w.size(), double(taps.factor));
-        first = false;
-        for (std::size_t i = 0; i < taps.w.size(); ++i)
-            std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]), double(taps.z[i]),
-                        double(taps.w[i]));
-        std::printf("], \"info\": [");
-        for (std::size_t i = 0; i < taps.w.size(); ++i) {
-            const ibl::detail::packed_cube::level& lv = packed.levels[std::size_t(taps.level[i])];
-            std::printf("%s%d, %d, %d, %d", i ? ", " : "", lv.n, lv.stride, lv.face_stride, lv.offset);
+    // Both LD weights (the peak kernel's two forms), each a chain of its own.
+    for (const ibl::ld_weight weight : {ibl::ld_weight::n_dot_l, ibl::ld_weight::g1}) {
+        o.weight = weight;
+        const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
+        const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(o, size);
+        for (std::size_t l = 0; l < plan.size(); ++l) {
+            const ibl::prefilter_level& lp = plan[l];
+            if (lp.level == 0) continue; // the mirror level is a copy
+            ibl::sphere_sample_table<float> table =
+                ibl::make_ld_table_for<float>(src, lp.roughness, lp.samples, o.method, o.lod_bias, o.weight);
+            table.trilinear = lp.trilinear;
+            const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
+            const int n = chain.size(int(l));
+            std::printf("%s{\"level\": %d, \"n\": %d, \"roughness\": %.17g, \"samples\": %u, \"trilinear\": %s, "
+                        "\"weight\": \"%s\", \"count\": %zu, \"factor\": %.9g, \"taps\": [",
+                        first ? "" : ", ", int(l), n, lp.roughness, lp.samples, lp.trilinear ? "true" : "false",
+                        o.weight == ibl::ld_weight::g1 ? "g1" : "nl", taps.w.size(), double(taps.factor));
+            first = false;
+            for (std::size_t i = 0; i < taps.w.size(); ++i)
+                std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]),
+                            double(taps.z[i]), double(taps.w[i]));
+            std::printf("], \"info\": [");
+            for (std::size_t i = 0; i < taps.w.size(); ++i) {
+                const ibl::detail::packed_cube::level& lv = packed.levels[std::size_t(taps.level[i])];
+                std::printf("%s%d, %d, %d, %d", i ? ", " : "", lv.n, lv.stride, lv.face_stride, lv.offset);
+            }
+            // The level's peaks as the row kernel adds them (prefilter_cube_source::level_peaks).
+            const ibl::peak_level pl =
+                split.empty() ? ibl::peak_level{}
+                              : ibl::make_peak_level(split.peaks, size, base.levels(), lp.roughness, o.weight,
+                                                     o.peaks.footprint, o.peaks.max_merge_angle, split.mean_luminance,
+                                                     o.peaks.cut);
+            std::printf("], \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"peaks\": [", pl.size(), double(pl.a2),
+                        pl.g1 ? "true" : "false");
+            for (std::size_t j = 0; j < pl.size(); ++j)
+                std::printf("%s%.9g, %.9g, %.9g, %.9g, %.9g, %.9g", j ? ", " : "", double(pl.px[j]), double(pl.py[j]),
+                            double(pl.pz[j]), double(pl.er[j]), double(pl.eg[j]), double(pl.eb[j]));
+            std::printf("], \"expect\": [");
+            for (int f = 0; f < 6; ++f)
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x) {
+                        const ibl::vec3<float> v = chain.texel(f, x, y, int(l));
+                        std::printf("%s%.9g, %.9g, %.9g", f || y || x ? ", " : "", double(v.x), double(v.y), double(v.z));
+                    }
+            std::printf("]}");
         }
-        std::printf("], \"expect\": [");
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x) {
-                    const ibl::vec3<float> v = chain.texel(f, x, y, int(l));
-                    std::printf("%s%.9g, %.9g, %.9g", f || y || x ? ", " : "", double(v.x), double(v.y), double(v.z));
-                }
-        std::printf("]}");
     }
     std::printf("]}\n");
 }

@@ -16,10 +16,13 @@ SwiftShader's WebGL2), compared with the C++.
            interactive viewer to --out (docs/shaders-viewer.png); with --page room, the room
            example (room.html) from --reference's JSON instead (docs/local_probes-room.png).
   prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
-           fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 32^2, packed,
-           and the fast filter's taps per level) and compares every texel of every convolved level
-           with the C++ chain (ibl::prefilter, method fast) within half-float rounding: |GLSL - C++|
-           <= 2^-11 |C++| per value.
+           fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 64^2 split by
+           the peak split, its base packed, and per LD weight and level the fast filter's taps and
+           merged peaks) and compares every texel of every convolved level with the C++ chain
+           (ibl::prefilter, method fast, peaks.cut = 0) within half-float rounding: |GLSL - C++|
+           <= 2^-11 |C++| per value. Then the viewer's own inputs (tools/viewer/refilter.js: the
+           split, the base's packing, the taps, the peak lists) against the C++ ones, and the
+           levels rendered from them against the C++ chain (1e-4 relative).
   bc6h     the browser's own BC6H decoder against the library's: the page uploads the blocks that
            `bc6h_fixtures` prints (random blocks of every mode code, reserved ones included, and
            blocks ibl::bc6h_encode_image made of HDR content) as one EXT_texture_compression_bptc
@@ -548,12 +551,13 @@ def compare_numeric(reference_exe, result):
 
 def compare_prefilter(fixtures, result):
     ok = True
-    by_level = {lv["level"]: lv for lv in result["levels"]}
+    by_level = {(lv["level"], lv["weight"]): lv for lv in result["levels"]}
     for lv in fixtures["levels"]:
-        got = by_level.get(lv["level"])
+        got = by_level.get((lv["level"], lv["weight"]))
         expect = lv["expect"]
+        name = f"level {lv['level']} ({lv['weight']})"
         if got is None or len(got["rgb"]) != len(expect):
-            print(f"level {lv['level']}: missing or wrong size")
+            print(f"{name}: missing or wrong size")
             ok = False
             continue
         worst, bad = 0.0, 0
@@ -563,24 +567,38 @@ def compare_prefilter(fixtures, result):
             worst = max(worst, ratio)
             if not abs(g - e) <= lim:
                 if bad < 3:
-                    print(f"  level {lv['level']} value {i}: GLSL {g!r} C++ {e!r}")
+                    print(f"  {name} value {i}: GLSL {g!r} C++ {e!r}")
                 bad += 1
-        print(f"level {lv['level']} ({lv['n']}^2 x 6, {lv['count']} taps): worst |diff| / (2^-11 |C++|) {worst:.3g}, "
-              f"{bad} values outside")
+        print(f"{name} ({lv['n']}^2 x 6, {lv['count']} taps, {lv['peak_count']} peaks): worst |diff| / (2^-11 |C++|) "
+              f"{worst:.3g}, {bad} values outside")
         ok = ok and bad == 0
     # The viewer's live path (tools/viewer/refilter.js): its packing and taps against the C++ ones,
     # and its render against the C++ chain (the taps' lods and weights agree to float rounding,
     # so within 1e-4 relative).
-    print(f"viewer packing: max relative difference from ibl::detail::pack_cube {result['packed_max_rel']:.3g}")
+    # The peak split (refilter.js splitPeaks, packSource with peaks, makePeakLevel) against the C++'s
+    # (split_cube_peaks, pack_cube of the base, make_peak_level): the same peaks, directions to float
+    # rounding, energies to 1e-5 relative (the threshold's mean is summed in another order).
+    print(f"viewer split: {result['source_peaks']} level-0 peaks (C++ {fixtures['source_peaks']}), threshold "
+          f"{result['threshold']:.9g} (C++ {fixtures['threshold']:.9g})")
+    ok = ok and result["source_peaks"] == fixtures["source_peaks"]
+    ok = ok and abs(result["threshold"] - fixtures["threshold"]) <= 1e-6 * fixtures["threshold"]
+    # The packing relative to max(|base texel|, |source texel|): the C++ takes a peak out of its float
+    # mips of the source, so a patched texel keeps the rounding of the source's (up to the sun's).
+    print(f"viewer packing: max difference from ibl::detail::pack_cube {result['packed_max_rel']:.3g} of the larger "
+          f"of the base's and the source's texel ({result['packed_max_rel_base']:.3g} of the base's)")
     ok = ok and result["packed_max_rel"] <= 1e-6
     for lv, d in zip(fixtures["levels"], result["taps"]):
-        print(f"viewer taps, level {lv['level']}: {d}")
+        print(f"viewer taps, level {lv['level']} ({lv['weight']}): {d}")
         ok = ok and "max_abs" in d and d["max_abs"] <= 1e-5 and abs(d["factor"] - d["expected_factor"]) <= 1e-6 * abs(d["expected_factor"])
-    by_level = {lv["level"]: lv for lv in result["js_levels"]}
+    for lv, d in zip(fixtures["levels"], result["peaks"]):
+        print(f"viewer peaks, level {lv['level']} ({lv['weight']}): {d} (C++ {lv['peak_count']} peaks)")
+        ok = ok and d.get("count") == lv["peak_count"] and "dir_max_abs" in d and d["dir_max_abs"] <= 1e-6 and \
+            d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"]
+    by_level = {(lv["level"], lv["weight"]): lv for lv in result["js_levels"]}
     for lv in fixtures["levels"]:
-        got = by_level.get(lv["level"])
+        got = by_level.get((lv["level"], lv["weight"]))
         worst = max(abs(g - e) / max(abs(e), 1e-30) for e, g in zip(lv["expect"], got["rgb"])) if got else float("inf")
-        print(f"viewer re-filter, level {lv['level']}: worst relative difference from ibl::prefilter {worst:.3g}")
+        print(f"viewer re-filter, level {lv['level']} ({lv['weight']}): worst relative difference from ibl::prefilter {worst:.3g}")
         ok = ok and worst <= 1e-4
     print(f"renderer: {result.get('renderer')}")
     print("PASS" if ok else "FAIL")

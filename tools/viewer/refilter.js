@@ -3,8 +3,11 @@
 // faces with a 1-texel border, levels by the exact solid-angle box filter: ibl::cubemap's
 // generate_mips and update_borders, ibl::detail::pack_cube) and the fast filter's taps per level
 // (ibl::make_fast_ld_table with the shapes of include/ibl/bake/prefilter_fast_tables.hpp, split
-// into single-level taps as ibl::detail::make_taps). Written after the C++ (same formulas, same
-// order), in double; tests/browser/run_browser_test.py --mode prefilter compares both with the C++.
+// into single-level taps as ibl::detail::make_taps), and the fast filter's peak split
+// (include/ibl/bake/prefilter_peaks.hpp: split_cube_peaks, merge_cube_peaks, make_peak_level): the
+// brightest texels leave the packed source and each level gets its merged peak list, which
+// ibl_prefilter_peaks adds back exactly. Written after the C++ (same formulas, same order), in
+// double; tests/browser/run_browser_test.py --mode prefilter compares all of it with the C++.
 
 // ---- cube geometry (env/cube_geometry.hpp) ------------------------------------------------------
 
@@ -57,8 +60,11 @@ function foldBorder(face, x, y, n) {
 
 /// Packs level 0 (six faces of n x n RGB(A) texels, `rgbOf(face, x, y)` -> [r, g, b]) with its
 /// full mip chain (power-of-two n): { data: Float32Array (4 per texel), levels: [{n, stride,
-/// faceStride, offset}] }, the layout of ibl::detail::pack_cube.
-export function packSource(n, rgbOf) {
+/// faceStride, offset}] }, the layout of ibl::detail::pack_cube. With `peaks` (splitPeaks' list)
+/// it packs the split's base as split_cube_peaks makes it: the mips of the source, then each
+/// peak's level-0 texel scaled to the threshold and, on every coarser level, the peak's energy over
+/// the covering texel's solid angle taken out (clamped at 0), the peaks in list order.
+export function packSource(n, rgbOf, peaks = null) {
     if (!(n >= 1) || (n & (n - 1)) !== 0) throw new Error(`re-filtering needs a power-of-two face, got ${n}`);
     const levels = [];
     let total = 0;
@@ -94,11 +100,24 @@ export function packSource(n, rgbOf) {
                         }
                     for (let k = 0; k < 3; ++k) cur[o + k] = acc[k] / w;
                 }
+        let out = cur; // what the level packs: the source's level, or the split's base
+        if (peaks && peaks.length) {
+            out = Float64Array.from(cur);
+            for (const p of peaks) {
+                const cx = p.x >> l, cy = p.y >> l, o = 3 * ((p.face * m + cy) * m + cx);
+                if (l === 0) {
+                    for (let k = 0; k < 3; ++k) out[o + k] = Math.fround(out[o + k] * p.scale);
+                    continue;
+                }
+                const om = texelSolidAngle(cx, cy, m);
+                for (let k = 0; k < 3; ++k) out[o + k] = Math.fround(Math.max(out[o + k] - p.energy[k] / om, 0));
+            }
+        }
         for (let f = 0; f < 6; ++f)
             for (let y = 0; y < m; ++y)
                 for (let x = 0; x < m; ++x) {
                     const o = 3 * ((f * m + y) * m + x), q = at(lv, f, x, y);
-                    for (let k = 0; k < 3; ++k) data[q + k] = cur[o + k];
+                    for (let k = 0; k < 3; ++k) data[q + k] = out[o + k];
                 }
         // Borders: the texel across each edge, the corners the mean of their three texels.
         for (let f = 0; f < 6; ++f) {
@@ -159,15 +178,8 @@ function kernel(theta, r, weight) {
     return Number.isFinite(k) && k > 0 ? k : 0;
 }
 
-/// Taps of one level: { taps: Float32Array (x, y, z, w per tap), info: Float32Array (n, stride,
-/// face stride, offset per tap), count, factor }, the tables ibl_prefilter.glsl reads.
-export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
-    const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
-    const n = Math.max(1, samples >>> 0);
-    const shape = fastShape(rows, r, n, weight);
-    const tail = Number.isFinite(shape.tail) && shape.tail > 0 ? shape.tail : 1;
-    const bias4 = Math.pow(2, 2 * shape.bias);
-    // The radial CDF (detail::make_fast_radial_cdf).
+/// The radial CDF of the kernel at roughness r (detail::make_fast_radial_cdf): { th, cdf, total }.
+function radialCdf(r, weight) {
     const m = 4096, lo = 1e-6 * 2 * Math.atan(Math.max(r * r, 1e-3)), hi = 0.5 * Math.PI;
     const th = [0], cdf = [0];
     let pt = 0, pf = 0, acc = 0;
@@ -179,6 +191,18 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
         pt = t, pf = f;
     }
     for (let i = 0; i < cdf.length; ++i) cdf[i] = acc > 0 ? cdf[i] / acc : 0;
+    return { th, cdf, total: acc };
+}
+
+/// Taps of one level: { taps: Float32Array (x, y, z, w per tap), info: Float32Array (n, stride,
+/// face stride, offset per tap), count, factor }, the tables ibl_prefilter.glsl reads.
+export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
+    const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
+    const n = Math.max(1, samples >>> 0);
+    const shape = fastShape(rows, r, n, weight);
+    const tail = Number.isFinite(shape.tail) && shape.tail > 0 ? shape.tail : 1;
+    const bias4 = Math.pow(2, 2 * shape.bias);
+    const { th, cdf, total: acc } = radialCdf(r, weight);
     const at = (u) => {
         let a = 0, b = cdf.length; // lower_bound
         while (a < b) { const c = (a + b) >> 1; if (cdf[c] < u) a = c + 1; else b = c; }
@@ -222,4 +246,115 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
         total = Math.fround(total + part);
     }
     return { taps: new Float32Array(taps), info: new Float32Array(info), count: taps.length / 4, factor: total > 0 ? Math.fround(1 / total) : 0 };
+}
+
+// ---- the peak split (include/ibl/bake/prefilter_peaks.hpp) ----------------------------------------
+
+/// peak_split_options' defaults (the C++ prefilter's; its row cut has no GPU counterpart: the GPU
+/// adds every peak of the list, what the C++ adds with cut = 0).
+export const peakDefaults = { ratio: 16, maxPeaks: 1024, footprint: 6, maxMergeAngle: 1 / 16 };
+
+const luminance = (c) => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+
+/// Unit direction through the centre of texel (x, y) of an n x n face, rounded to float.
+function texelDirection(face, x, y, n) {
+    const p = facePoint(face, 2 * ((x + 0.5) / n) - 1, 2 * ((y + 0.5) / n) - 1), l = Math.hypot(p[0], p[1], p[2]);
+    return p.map((v) => Math.fround(v / l));
+}
+
+/// split_cube_peaks on level 0 (six faces of n x n texels, `rgbOf(face, x, y)` -> [r, g, b]): the
+/// threshold T = max(ratio x the solid-angle mean luminance, the (maxPeaks + 1)-th brightest
+/// luminance) and the level-0 peaks above it, in face, row, column order: { peaks: [{ face, x, y,
+/// dir, energy (Omega x the radiance above T), weight (the luminance energy), scale (T / luminance:
+/// the base texel's factor) }], mean, threshold }. No texel above T: no peaks (the source is packed as is).
+export function splitPeaks(n, rgbOf, opt = peakDefaults) {
+    const count = 6 * n * n, lum = new Float64Array(count), rgb = new Float64Array(3 * count);
+    let acc = 0;
+    for (let f = 0; f < 6; ++f)
+        for (let y = 0; y < n; ++y)
+            for (let x = 0; x < n; ++x) {
+                const i = (f * n + y) * n + x, c = rgbOf(f, x, y);
+                for (let k = 0; k < 3; ++k) rgb[3 * i + k] = c[k];
+                const l = Math.fround(luminance(c));
+                lum[i] = Number.isFinite(l) && l > 0 ? l : 0;
+                acc += lum[i] * texelSolidAngle(x, y, n);
+            }
+    const mean = acc / (4 * Math.PI);
+    let t = Number.isFinite(opt.ratio) && opt.ratio > 0 ? opt.ratio * mean : 0;
+    let above = 0;
+    for (const l of lum) above += l > t ? 1 : 0;
+    if (above > opt.maxPeaks) { // the threshold that keeps at most maxPeaks texels above it
+        const sorted = Float64Array.from(lum).sort();
+        t = Math.max(t, sorted[count - 1 - opt.maxPeaks]);
+    }
+    const peaks = [];
+    if (!(t > 0)) return { peaks, mean, threshold: t };
+    for (let f = 0; f < 6; ++f)
+        for (let y = 0; y < n; ++y)
+            for (let x = 0; x < n; ++x) {
+                const i = (f * n + y) * n + x, l = lum[i];
+                if (!(l > t)) continue;
+                const om = texelSolidAngle(x, y, n), e = (1 - t / l) * om;
+                peaks.push({ face: f, x, y, dir: texelDirection(f, x, y, n), energy: [0, 1, 2].map((k) => rgb[3 * i + k] * e),
+                             weight: (l - t) * om, scale: t / l });
+            }
+    return { peaks, mean, threshold: t };
+}
+
+/// merge_cube_peaks: the peaks merged into the texels of mip `mip` (summed energy at the
+/// luminance-energy centroid), in face, row, column order of the merged texels.
+function mergePeaks(peaks, mip) {
+    if (mip <= 0) return peaks;
+    const at = new Map();
+    for (const p of peaks) {
+        const key = [p.face, p.y >> mip, p.x >> mip];
+        const id = key.join(',');
+        let q = at.get(id);
+        if (!q) at.set(id, (q = { key, face: p.face, x: p.x >> mip, y: p.y >> mip, energy: [0, 0, 0], weight: 0, c: [0, 0, 0] }));
+        for (let k = 0; k < 3; ++k) q.energy[k] += p.energy[k], q.c[k] += p.weight * p.dir[k];
+        q.weight += p.weight;
+    }
+    const out = [...at.values()].sort((a, b) => a.key[0] - b.key[0] || a.key[1] - b.key[1] || a.key[2] - b.key[2]);
+    for (const q of out) {
+        const len = Math.hypot(q.c[0], q.c[1], q.c[2]);
+        q.dir = len > 0 ? q.c.map((v) => Math.fround(v / len)) : [0, 0, 1];
+    }
+    return out;
+}
+
+/// ggx_ld_fwhm: the LD kernel's full width at half maximum at roughness r (radians, at most pi).
+function ggxLdFwhm(r) {
+    const a = Math.max(Math.min(1, Math.max(0, r)) ** 2, 1e-4), a2 = a * a;
+    if (a2 >= 1) return Math.PI;
+    const omc = 2 * (Math.sqrt(2) - 1) * a2 / (1 - a2);
+    return Math.min(Math.PI, 2 * Math.acos(Math.max(-1, 1 - omc)));
+}
+
+/// peak_merge_mip: the coarsest mip m <= maxMip whose face-centre texel, 2 / (n0 >> m) radians, is
+/// at most min(fwhm / footprint, maxAngle).
+function peakMergeMip(r, n0, maxMip, footprint, maxAngle) {
+    const want = Math.min(ggxLdFwhm(r) / Math.max(footprint, 1), maxAngle);
+    let m = 0;
+    while (m < maxMip && (n0 >> (m + 1)) >= 1 && 2 / (n0 >> (m + 1)) <= want) ++m;
+    return m;
+}
+
+/// make_peak_level: a level's peaks for ibl_prefilter_peaks (the split's peaks of an n0-texel level 0
+/// with `sourceLevels` mips, merged at peakMergeMip, energies pre-scaled by alpha^2 / (4 pi
+/// integral K)): { peak_count, peaks: Float32Array (x, y, z, er, eg, eb per peak), a2, g1 }.
+export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults) {
+    const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false };
+    if (!peaks.length) return none;
+    const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
+    const a = Math.max(r * r, 1e-4), a2 = a * a;
+    const norm = 2 * Math.PI * radialCdf(r, weight).total;
+    if (!(norm > 0)) return none;
+    const scale = a2 / (4 * Math.PI * norm);
+    const merged = mergePeaks(peaks, peakMergeMip(r, n0, sourceLevels - 1, opt.footprint, opt.maxMergeAngle));
+    const out = new Float32Array(6 * merged.length);
+    merged.forEach((p, j) => {
+        out.set(p.dir, 6 * j);
+        for (let k = 0; k < 3; ++k) out[6 * j + 3 + k] = p.energy[k] * scale;
+    });
+    return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1' };
 }

@@ -31,7 +31,7 @@
 // for Zstandard-supercompressed files (--ktx2-zstd N), the panel says so and nothing is drawn.
 
 import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
-import { packSource, parseFastShapes, fastTaps } from './refilter.js';
+import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel } from './refilter.js';
 
 const params = new URLSearchParams(location.search);
 const testMode = params.get('test');
@@ -311,21 +311,33 @@ function packedTexture(gl, data, width) {
 }
 
 /// The passes of ibl_prefilter.glsl, one per face of each level: the packed source bound on unit 0;
-/// per level { n, count, factor, taps, info } its taps uploaded on unit 1; target(level, face) binds
-/// the framebuffer's attachment before a pass, done(level, face) runs after it. Returns the tap
-/// textures it made (the caller deletes them).
+/// per level { n, count, factor, taps, info } its taps uploaded on unit 1 and, with { peak_count,
+/// peaks (px, py, pz, er, eg, eb per peak), a2, g1 } (the peak split, make_peak_level), its peaks
+/// on unit 3 (a 1 x 2 zero texture without); target(level, face) binds the framebuffer's attachment
+/// before a pass, done(level, face) runs after it. Returns the textures it made (the caller deletes them).
 function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     const u = (name) => gl.getUniformLocation(program, name);
     gl.useProgram(program);
     gl.bindVertexArray(vao);
     gl.uniform1i(u('u_src'), 0);
     gl.uniform1i(u('u_taps'), 1);
+    gl.uniform1i(u('u_peaks'), 3);
     const made = [];
     for (const lv of levels) {
         const both = new Float32Array(8 * lv.count);
         both.set(lv.taps);
         both.set(lv.info, 4 * lv.count);
         made.push(floatTexture(gl, 1, lv.count, 2, both));
+        const np = lv.peak_count || 0, peaks = new Float32Array(8 * Math.max(1, np));
+        for (let j = 0; j < np; ++j)
+            for (let c = 0; c < 3; ++c) {
+                peaks[4 * j + c] = lv.peaks[6 * j + c];
+                peaks[4 * (np + j) + c] = lv.peaks[6 * j + 3 + c];
+            }
+        made.push(floatTexture(gl, 3, Math.max(1, np), 2, peaks));
+        gl.uniform1i(u('u_peak_count'), np);
+        gl.uniform1f(u('u_peak_a2'), np ? lv.a2 : 0);
+        gl.uniform1i(u('u_peak_g1'), np && lv.g1 ? 1 : 0);
         gl.uniform1i(u('u_count'), lv.count);
         gl.uniform1f(u('u_factor'), lv.factor);
         gl.uniform1i(u('u_n'), lv.n);
@@ -391,10 +403,12 @@ class Renderer {
     }
 
     /// Re-filters the loaded chain's levels >= 1 from its level 0 on the GPU with the fast filter
-    /// (ibl_prefilter.glsl: refilter.js packs level 0 with its mips and builds each level's taps at
-    /// the level's roughness from report.json, 32 * 2^(v - 1) samples at virtual level v, trilinear
-    /// reads, the chain's LD weight) and renders every face of every level into the chain texture.
-    /// Returns { prepare_ms (packing and taps, CPU), gpu_ms (the passes, to gl.finish) }.
+    /// (ibl_prefilter.glsl: refilter.js splits level 0's peaks off as the C++ prefilter does with its
+    /// default peak_split_options, packs the split's base with its mips and builds each level's taps
+    /// at the level's roughness from report.json, 32 * 2^(v - 1) samples at virtual level v,
+    /// trilinear reads, the chain's LD weight, and its merged peaks) and renders every face of every
+    /// level into the chain texture. Returns { prepare_ms (split, packing, taps and peaks, CPU),
+    /// gpu_ms (the passes, to gl.finish), levels, peaks (level-0 peaks) }.
     refilter(prefilterFragment, shapesText) {
         const gl = this.gl, bake = this.bake, chain = bake.chain;
         const spec = bake.report && bake.report.specular;
@@ -404,17 +418,20 @@ class Renderer {
         if (!this.prefilterProgram) this.prefilterProgram = compile(gl, VERTEX, HEADER + this.glsl + '\n' + prefilterFragment);
         const t0 = performance.now();
         const l0 = chain.levels[0], n0 = l0.size, half = chain.vkFormat === 97;
-        const packed = packSource(n0, (f, x, y) => {
+        const rgbOf = (f, x, y) => {
             const a = l0.faces[f], i = 4 * (y * n0 + x);
             return half ? [halfToFloat(a[i]), halfToFloat(a[i + 1]), halfToFloat(a[i + 2])] : [a[i], a[i + 1], a[i + 2]];
-        });
+        };
+        const split = splitPeaks(n0, rgbOf); // the peak split with the C++ prefilter's defaults
+        const packed = packSource(n0, rgbOf, split.peaks);
         const shapes = parseFastShapes(shapesText);
         const weight = spec.ld_weight === 'g1' ? 'g1' : 'nl';
         const plan = [];
         spec.levels.forEach((lv, k) => {
             if (k === 0 || !(lv.virtual_level > 0) || k >= chain.levels.length) return;
             const samples = Math.min(16384, 32 * 2 ** (lv.virtual_level - 1));
-            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed) });
+            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed),
+                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight) });
         });
         const t1 = performance.now();
         const srcTex = packedTexture(gl, packed.data, 4096);
@@ -427,7 +444,7 @@ class Renderer {
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
         gl.deleteFramebuffer(fb);
         for (const t of made.concat([srcTex])) gl.deleteTexture(t);
-        return { prepare_ms: t1 - t0, gpu_ms: t2 - t1, levels: plan.length };
+        return { prepare_ms: t1 - t0, gpu_ms: t2 - t1, levels: plan.length, peaks: split.peaks.length };
     }
 
     /// Draws into the canvas at its current size. view: { mode, roughness, ev, lookup, multiscatter,
@@ -662,16 +679,26 @@ async function runPrefilterTest() {
     const fx = JSON.parse(await fetchText(params.get('bake') + 'prefilter_fixtures.json'));
     gl.pixelStorei(gl.UNPACK_ALIGNMENT, 1);
     const vao = gl.createVertexArray();
-    // The viewer's own inputs (refilter.js) for the same source: the packing from level 0's
-    // interior and the taps from the level's roughness, samples and weight.
-    const n0 = fx.size, st0 = n0 + 2;
-    const js = packSource(n0, (f, x, y) => {
-        const k = 4 * (f * st0 * st0 + (y + 1) * st0 + (x + 1));
-        return [fx.packed[k], fx.packed[k + 1], fx.packed[k + 2]];
-    });
-    let packedDiff = 0;
-    for (let k = 0; k < js.data.length; ++k)
-        if (k % 4 !== 3) packedDiff = Math.max(packedDiff, Math.abs(js.data[k] - fx.packed[k]) / Math.max(1e-30, Math.abs(fx.packed[k])));
+    // The viewer's own inputs (refilter.js) for the same source: the peak split of the source's
+    // level 0, the split's base packed, the taps from the level's roughness, samples and weight,
+    // and each level's peaks.
+    const n0 = fx.size;
+    const srcOf = (f, x, y) => {
+        const k = 3 * ((f * n0 + y) * n0 + x);
+        return [fx.source[k], fx.source[k + 1], fx.source[k + 2]];
+    };
+    const split = splitPeaks(n0, srcOf);
+    const js = packSource(n0, srcOf, split.peaks);
+    // Relative to the larger of the base's and the source's texel: where a peak was taken out of a
+    // mip the C++ subtracts it from its float mip of the source, whose rounding the difference keeps.
+    const whole = split.peaks.length ? packSource(n0, srcOf) : js;
+    let packedDiff = 0, packedDiffBase = 0;
+    for (let k = 0; k < js.data.length; ++k) {
+        if (k % 4 === 3) continue;
+        const d = Math.abs(js.data[k] - fx.packed[k]);
+        packedDiff = Math.max(packedDiff, d / Math.max(1e-30, Math.abs(fx.packed[k]), Math.abs(whole.data[k])));
+        packedDiffBase = Math.max(packedDiffBase, d / Math.max(1e-30, Math.abs(fx.packed[k])));
+    }
     const shapes = parseFastShapes(await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
     const jsTaps = fx.levels.map((lv) => fastTaps(shapes, lv.roughness, lv.samples, lv.weight, lv.trilinear, js));
     const tapsDiff = fx.levels.map((lv, i) => {
@@ -680,6 +707,18 @@ async function runPrefilterTest() {
         let d = 0;
         for (let k = 0; k < 4 * lv.count; ++k) d = Math.max(d, Math.abs(t.taps[k] - lv.taps[k]), Math.abs(t.info[k] - lv.info[k]));
         return { max_abs: d, factor: t.factor, expected_factor: lv.factor };
+    });
+    const jsPeaks = fx.levels.map((lv) => makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight));
+    const peaksDiff = fx.levels.map((lv, i) => {
+        const p = jsPeaks[i];
+        if (p.peak_count !== lv.peak_count || p.g1 !== lv.g1) return { count: p.peak_count, expected: lv.peak_count };
+        let dir = 0, energy = 0;
+        for (let j = 0; j < 6 * p.peak_count; ++j) {
+            const d = Math.abs(p.peaks[j] - lv.peaks[j]);
+            if (j % 6 < 3) dir = Math.max(dir, d);
+            else energy = Math.max(energy, d / Math.max(1e-30, Math.abs(lv.peaks[j])));
+        }
+        return { count: p.peak_count, dir_max_abs: dir, energy_max_rel: energy, a2: p.a2, expected_a2: lv.a2 };
     });
     // Each level into an RGBA32F target, read back face by face (rows from y = 0: the chain's order).
     const render = (levels) => {
@@ -699,7 +738,7 @@ async function runPrefilterTest() {
             const px = new Float32Array(4 * lv.n * lv.n);
             gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
             for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(px[4 * k], px[4 * k + 1], px[4 * k + 2]);
-            if (f === 5) out.push({ level: lv.level, n: lv.n, rgb });
+            if (f === 5) out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
         });
         return out;
     };
@@ -707,8 +746,10 @@ async function runPrefilterTest() {
     const levels = render(fx.levels);
     // The whole live path: the viewer's packing and taps through the same shader.
     packedTexture(gl, js.data, fx.width);
-    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, n: lv.n, ...jsTaps[i] })));
-    await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff, taps: tapsDiff, renderer: rendererName(gl) });
+    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] })));
+    await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
+                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff,
+                 source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });
 }
 
 /// The BC6H decoder test: the fixtures' blocks (tests/browser/bc6h_fixtures.cpp, served as
@@ -837,7 +878,7 @@ async function runViewer() {
         if (!ready) return;
         try {
             const t = renderer.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
-            el('refilter_v').textContent = `${t.levels} levels: ${t.gpu_ms.toFixed(1)} ms GPU + ${t.prepare_ms.toFixed(1)} ms CPU`;
+            el('refilter_v').textContent = `${t.levels} levels, ${t.peaks} peaks: ${t.gpu_ms.toFixed(1)} ms GPU + ${t.prepare_ms.toFixed(1)} ms CPU`;
             redraw();
         } catch (e) {
             log(String(e.message || e));

@@ -11,6 +11,11 @@
 //   taps  RGBA32F 2-D texture of `count` x 2 texels: row 0 the tap (x, y, z, w) (tangent-space
 //         direction, weight), row 1 its source level (n, n + 2, (n + 2)^2, offset of the level);
 //   factor  make_taps' scale / norm (norm: the weights summed in blocks of 32, as here).
+//   peaks (optional: the fast filter's peak split, bake/prefilter_peaks.hpp) RGBA32F 2-D texture
+//         of `peak_count` x 2 texels, a level's merged peaks as make_peak_level builds them: row 0
+//         the peak's unit direction (x, y, z, 0), row 1 its pre-scaled energy (er, eg, eb, 0); with
+//         the level's a2 (alpha^2) and LD weight (g1: ld_weight::g1, else n.l). The source is then
+//         the split's base (split_cube_peaks), packed. ibl_prefilter_peaks adds them exactly.
 // Every operation is the C++ kernel's in the same order (the frame, the branch-free face selection,
 // the bordered bilinear address and weights, the blocks of 32 taps), so the result equals the
 // C++ within float rounding (the browser test: within half-float rounding on every level).
@@ -90,6 +95,33 @@ vec3 ibl_prefilter_texel(sampler2D src, sampler2D taps, int count, float factor,
         total += block;
     }
     return total.rgb * factor;
+}
+
+// The peaks of a level added back exactly (bake/prefilter_peaks.hpp detail::splat_peaks_row): sum
+// over the list of E_j K(c), c = dir . d_j, cp = max(c, 0), q = (1 - cp) / 2 + a2 (1 + cp) / 2,
+// K = cp / q^2 (n.l) or cp (2 / (cp + sqrt(a2 + (1 - a2) cp^2))) / q^2 (g1); 0 behind the peak.
+// The C++ adds this sum to the tap set's result after it, in list order, as here; it skips the
+// peaks behind a whole face row (whose terms are 0) and, with peak_split_options::cut > 0, the
+// negligible ones: cut = 0 gives the sum here. peak_count 0: the tap set only.
+vec3 ibl_prefilter_peaks(sampler2D peaks, int peak_count, float a2, bool g1, vec3 dir) {
+    float ha2 = 0.5 * a2, one_minus_a2 = 1.0 - a2;
+    vec3 acc = vec3(0.0);
+    for (int j = 0; j < peak_count; ++j) {
+        vec4 d = texelFetch(peaks, ivec2(j, 0), 0);
+        vec4 e = texelFetch(peaks, ivec2(j, 1), 0);
+        float c = dir.x * d.x + dir.y * d.y + dir.z * d.z;
+        float cp = c > 0.0 ? c : 0.0;
+        float q = 0.5 * (1.0 - cp) + ha2 * (1.0 + cp);
+        float k;
+        if (g1) {
+            float g = 2.0 / (cp + sqrt(a2 + one_minus_a2 * cp * cp)); // G1 / n.l
+            k = cp * g / (q * q);
+        } else {
+            k = cp / (q * q);
+        }
+        acc += e.rgb * k;
+    }
+    return acc;
 }
 
 #endif // IBL_GLSL_PREFILTER
