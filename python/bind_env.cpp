@@ -197,7 +197,7 @@ lobe_tables tabulate_lobe(const char* fn, const py::object& model, std::vector<d
 }
 
 py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std::string& method, const std::string& weight,
-                   unsigned threads, py::object model) {
+                   unsigned threads, py::object model, py::object peaks) {
     const bool py_lobe = is_python_lobe("prefilter", model);
     ibl::prefilter_options opt;
     if (method == "fis") opt.method = ibl::prefilter_method::filtered_importance;
@@ -210,6 +210,19 @@ py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std
     if (levels < -1) throw py::value_error("ibl.prefilter: levels must be -1 (automatic), 0 (full chain) or positive");
     opt.levels = levels;
     opt.samples = samples;
+    // The fast filter's peak split (bake/prefilter_peaks.hpp) needs the closed-form GGX kernel: on
+    // by default for the built-in lobe, off for a Python model (asking for it there is an error).
+    if (!peaks.is_none()) {
+        const long long p = peaks.cast<long long>();
+        if (p < 0 || p > (1ll << 30)) throw py::value_error("ibl.prefilter: peaks must be in [0, 2^30], got " + std::to_string(p));
+        if (p > 0 && py_lobe)
+            throw py::value_error("ibl.prefilter: peaks > 0 is the fast filter's peak split through the closed-form GGX "
+                                  "kernel, for the built-in lobe only; a Python model takes peaks=0 (or None)");
+        opt.peaks.enabled = p > 0;
+        opt.peaks.max_peaks = std::uint32_t(p);
+    } else if (py_lobe) {
+        opt.peaks.enabled = false;
+    }
     if (py_lobe && opt.weight == ibl::ld_weight::g1)
         throw py::value_error("ibl.prefilter: weight='g1' is the GGX G1 weight, for the built-in lobe only; a Python "
                               "model's lobe takes weight='n_dot_l'");
@@ -628,6 +641,7 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
 void bind_env(py::module_& m) {
     m.def("prefilter", &prefilter, py::arg("cube"), py::kw_only(), py::arg("levels") = -1, py::arg("samples") = 0u,
           py::arg("method") = "fis", py::arg("weight") = "n_dot_l", py::arg("threads") = 0u, py::arg("model") = py::none(),
+          py::arg("peaks") = py::none(),
           "The prefiltered specular chain of ibl::prefilter (N = V = R): a list of float32 arrays\n"
           "(6, s, s, 3), level l of face size max(1, n >> l) for roughness l / (levels - 1).\n"
           "cube: (6, n, n, 3), faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0. levels: -1\n"
@@ -636,7 +650,9 @@ void bind_env(py::module_& m) {
           "weight 'n_dot_l' (Karis) or 'g1'. threads: 0 = all cores. model: None or 'ggx' (the built-in\n"
           "GGX lobe) or a Python model with alpha(roughness) and ndf(n_dot_h, alpha): its LD lobe,\n"
           "tabulated from one vectorised ndf call on a fine grid of n.h per level roughness\n"
-          "(weight 'n_dot_l' only).");
+          "(weight 'n_dot_l' only). peaks: the fast filter's peak split, at most this many source texels\n"
+          "taken out of the tap set and added back through the closed-form GGX kernel (None = 1024 for\n"
+          "the built-in lobe, off for a Python model; 0 = off).");
     m.def("irradiance", &irradiance, py::arg("cube"), py::arg("size") = 32, py::kw_only(), py::arg("samples") = 1024u,
           py::arg("method") = "cosine", py::arg("threads") = 0u,
           "Irradiance cube (6, size, size, 3) float32 of ibl::irradiance_cubemap: E(n) at every texel\n"

@@ -151,6 +151,8 @@ struct prefilter_options {
     double lod_bias = 0.5;
     /// Cubemap fast path: trilinear reads (two bilinear taps per sample, the default); false reads
     /// only the nearest level round(lod) (one tap: half the cost, the lod quantised to whole levels).
+    /// Read by filtered and plain importance sampling; the fast filter's plan reads the nearest
+    /// level (prefilter_plan; a level_plan sets any reads).
     bool trilinear = true;
     /// The LD weight (header: "LD weight"); the default is Karis's n.l.
     ld_weight weight = ld_weight::n_dot_l;
@@ -332,17 +334,18 @@ inline std::uint32_t prefilter_samples(const prefilter_options& opt, int level, 
 
 /// The levels prefilter computes for the options (header: "Level plan"): opt.level_plan when set,
 /// else levels 0 .. prefilter_levels(opt, base_size) - 1 at roughness opt.policy.roughness(l, levels)
-/// with prefilter_samples(opt, l, levels) samples and opt.trilinear reads (a mirror level 0 of lobe
-/// L reads at the footprint's lod). Throws as prefilter_levels.
+/// with prefilter_samples(opt, l, levels) samples and opt.trilinear reads, nearest reads for the
+/// fast filter (a mirror level 0 of lobe L reads at the footprint's lod). Throws as prefilter_levels.
 template <class Lobe = ggx_lobe>
     requires ld_lobe<Lobe>
 std::vector<prefilter_level> prefilter_plan(const prefilter_options& opt, int base_size) {
     if (!opt.level_plan.empty()) return opt.level_plan;
     const int levels = prefilter_levels(opt, base_size);
     std::vector<prefilter_level> plan;
+    const bool reads = opt.method == prefilter_method::fast ? false : opt.trilinear;
     for (int l = 0; l < levels; ++l)
         plan.push_back({l, opt.policy.roughness(double(l), levels), prefilter_samples(opt, l, levels),
-                        opt.trilinear || (l == 0 && lobe_mirror_limit<Lobe>())});
+                        reads || (l == 0 && lobe_mirror_limit<Lobe>())});
     return plan;
 }
 

@@ -31,8 +31,9 @@
 // Each row records filtered importance sampling's error at the same N: the fitted shapes are
 // below it at 239 of the 240 rows (within 1.2% at the other: g1, r = 0.7, N = 8).
 //
-// Cost: N samples per texel (two bilinear taps each with trilinear reads), the default schedule
-// fast_default_samples * 2^(l - 1) against 512 * 2^(l - 1) for filtered importance sampling.
+// Cost: N samples per texel (one bilinear tap each from the nearest level, the default plan's
+// reads; two with trilinear reads), the default schedule fast_default_samples * 2^(l - 1) against
+// 512 * 2^(l - 1) trilinear samples for filtered importance sampling.
 // Error and time: docs/ibl-bake.md ("Fast filter") and bench/bench_prefilter.cpp.
 //
 // Determinism: the table depends only on the roughness, N, the weight and the source's lod
@@ -67,9 +68,10 @@ inline double fast_lobe_scale(double roughness) noexcept {
 }
 
 /// Samples per texel at level 1 of the fast filter's default schedule (doubling per level, as
-/// default_prefilter_samples): a sixteenth of filtered importance sampling's default, about a
-/// tenth of its time (docs/ibl-bake.md, "Fast filter", has the error this costs).
-inline constexpr std::uint32_t fast_default_samples = 32;
+/// default_prefilter_samples): an eighth of filtered importance sampling's default, read from the
+/// nearest level (one tap each: a sixteenth of its taps). At equal taps, nearest reads of twice
+/// the samples are the more accurate (docs/ibl-bake.md, "Fast filter", has the error and time).
+inline constexpr std::uint32_t fast_default_samples = 64;
 
 /// The tabulated shape (bake/prefilter_fast_tables.hpp) for a weight, a roughness and a sample
 /// budget: among the rows of that weight, those of the largest tabulated budget <= samples (the

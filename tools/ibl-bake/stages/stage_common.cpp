@@ -429,7 +429,8 @@ ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specul
     o.weight = w;
     o.method = method == prefilter_choice::fast ? ibl::prefilter_method::fast : ibl::prefilter_method::filtered_importance;
     for (const ibl::specular_level_plan& lp : sp.levels) // the mirror level copies the nearest source level
-        o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method), lp.level > 0 && lp.trilinear});
+        o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method),
+                                lp.level > 0 && lp.trilinear && method != prefilter_choice::fast});
     return ibl::cubemap<float>(ibl::prefilter(src, o, ex));
 }
 

@@ -174,7 +174,7 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
     lc.size = chain_->size(k);
     lc.roughness = lp.roughness;
     lc.samples = lp.samples;
-    lc.trilinear = lp.trilinear;
+    lc.trilinear = lp.trilinear && method_ != prefilter_choice::fast; // the fast filter reads the nearest level
     const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qs_.ref_grid, ctx.light);
     std::vector<dvec3> ref(texels.size());
     ctx.src.visit([&](const auto& env) {
@@ -213,7 +213,7 @@ std::vector<table_row> specular_stage::rows() const {
     const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
                                 ? std::to_string(chain_samples(qs_.prefilter_samples, method_)) + "*2^(l-1) spp"
                                 : "planned spp";
-    const std::string method = std::string(fast ? "GGX fast filter" : "GGX filtered IS") + (sp_.trilinear ? " (trilinear)" : "");
+    const std::string method = std::string(fast ? "GGX fast filter" : "GGX filtered IS") + (sp_.trilinear && !fast ? " (trilinear)" : "");
     const std::string brief = fast ? "GGX fast filter" : "GGX filtered IS";
     const std::string cost = spp + ", " + std::to_string(sp_.levels.size()) + " levels";
     if (!checked_) return {table_row{"specular chain", method, cost, ms_, "not checked (--checks none)"}.compact(brief, "not checked")};
@@ -298,7 +298,8 @@ void specular_stage::report(json_writer& j) const {
                                                 (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel), "
                                                            : "), ")
                                           : "GGX filtered importance sampling (Krivanek-Colbert), ") +
-                          (sp_.trilinear ? "trilinear" : "nearest-level") + " source reads, N = V = R, weight " +
+                          (sp_.trilinear && method_ != prefilter_choice::fast ? "trilinear" : "nearest-level") +
+                          " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
     j.key("ld_weight").value(to_string(weight_));
     j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? chain_samples(sp_.levels[1].samples, method_) : 0u);
@@ -347,7 +348,7 @@ void specular_stage::report_levels(json_writer& j) const {
         j.key("size").value(chain_->size(int(k)));
         j.key("roughness").value(lp.roughness);
         j.key("samples").value(chain_samples(lp.samples, method_));
-        j.key("trilinear").value(lp.trilinear);
+        j.key("trilinear").value(lp.trilinear && method_ != prefilter_choice::fast);
         if (c) {
             j.key("texels_compared").value(c->texels);
             j.key("rel_rmse").value(c->m.rel_rmse);

@@ -209,9 +209,10 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
 
 /// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
 /// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
-/// The fast filter's samples per level are the plan's (filtered importance sampling's) / 16, at
-/// least 8: 32 * 2^(l - 1) at the default quality (ibl::fast_default_samples).
-inline constexpr std::uint32_t fast_samples_divisor = 16;
+/// The fast filter's samples per level are the plan's (filtered importance sampling's) / 8, at
+/// least 8: 64 * 2^(l - 1) at the default quality (ibl::fast_default_samples), read from the
+/// nearest level (the library's default plan for the fast filter).
+inline constexpr std::uint32_t fast_samples_divisor = 8;
 /// The samples a level of the chain is filtered with: the plan's for fis, the fast filter's for fast.
 std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method);
 /// The plan's chain filtered by `method` (ibl::prefilter with a level plan).
