@@ -35,17 +35,19 @@ ibl::sky_environment<float> sky_f(int env) {
     return s;
 }
 
-const ibl::cubemap<float>& source(int env) {
-    static std::array<ibl::cubemap<float>*, 2> cache{};
-    if (!cache[std::size_t(env)])
-        cache[std::size_t(env)] = new ibl::cubemap<float>(ibl::bake_cubemap<float>(sky_f(env), base, env == 0 ? 2 : 4, ibl::thread_executor{2}));
-    return *cache[std::size_t(env)];
+const ibl::cubemap<float>& source(int env, int size = base) {
+    static std::array<ibl::cubemap<float>*, 4> cache{};
+    const std::size_t k = std::size_t(env) + (size == base ? 0 : 2);
+    if (!cache[k])
+        cache[k] = new ibl::cubemap<float>(ibl::bake_cubemap<float>(sky_f(env), size, env == 0 ? 2 : 4, ibl::thread_executor{2}));
+    return *cache[k];
 }
 
 /// Reference LD per level (index l = 1..levels-1), texels in cubemap order.
-const std::vector<std::vector<ibl::vec3<double>>>& reference(int env) {
-    static std::array<std::vector<std::vector<ibl::vec3<double>>>*, 2> cache{};
-    if (!cache[std::size_t(env)]) {
+const std::vector<std::vector<ibl::vec3<double>>>& reference(int env, int size = base) {
+    static std::array<std::vector<std::vector<ibl::vec3<double>>>*, 4> cache{};
+    const std::size_t k = std::size_t(env) + (size == base ? 0 : 2);
+    if (!cache[k]) {
         auto s = ibl::make_default_sky<double>();
         if (env == 0) s.sun_radiance = ibl::vec3<double>(0.0);
         auto* ref = new std::vector<std::vector<ibl::vec3<double>>>(levels);
@@ -53,16 +55,16 @@ const std::vector<std::vector<ibl::vec3<double>>>& reference(int env) {
         for (int l = 1; l < levels; ++l) {
             const double r = policy.roughness(double(l), levels);
             (*ref)[std::size_t(l)] = ibl::reference_faces(
-                base >> l, [&](const ibl::vec3<double>& d) { return ibl::reference_ld_sky(s, d, r, 2048, 16); },
+                size >> l, [&](const ibl::vec3<double>& d) { return ibl::reference_ld_sky(s, d, r, 2048, 16); },
                 ibl::thread_executor{2});
         }
-        cache[std::size_t(env)] = ref;
+        cache[k] = ref;
     }
-    return *cache[std::size_t(env)];
+    return *cache[k];
 }
 
-void report(benchmark::State& state, const ibl::cubemap<float>& out, int env) {
-    const auto& ref = reference(env);
+void report(benchmark::State& state, const ibl::cubemap<float>& out, int env, int size = base) {
+    const auto& ref = reference(env, size);
     for (int l = 1; l < levels; ++l) {
         const ibl::error_metrics m = ibl::compare_level(out, l, std::span<const ibl::vec3<double>>(ref[std::size_t(l)]));
         state.counters["rel_" + std::to_string(l)] = m.rel_rmse;
@@ -71,9 +73,9 @@ void report(benchmark::State& state, const ibl::cubemap<float>& out, int env) {
     }
 }
 
-void run_chain(benchmark::State& state, const ibl::prefilter_options& o, int env) {
-    const ibl::cubemap<float>& src = source(env);
-    (void)reference(env); // outside the timed loop
+void run_chain(benchmark::State& state, const ibl::prefilter_options& o, int env, int size = base) {
+    const ibl::cubemap<float>& src = source(env, size);
+    (void)reference(env, size); // outside the timed loop
     ibl::cubemap<float> out(1);
     for (auto _ : state) {
         out = ibl::prefilter(src, o, ibl::thread_executor{2});
@@ -82,7 +84,7 @@ void run_chain(benchmark::State& state, const ibl::prefilter_options& o, int env
     std::size_t texels = 0;
     for (int l = 1; l < out.levels(); ++l) texels += std::size_t(6) * std::size_t(out.size(l)) * std::size_t(out.size(l));
     state.SetItemsProcessed(std::int64_t(state.iterations()) * std::int64_t(texels));
-    report(state, out, env);
+    report(state, out, env, size);
 }
 
 /// A sweep point: `levels` levels, range(1) samples at every level >= 1, nearest-level reads.
@@ -110,6 +112,18 @@ void BM_prefilter_fis(benchmark::State& state) { run_sweep(state, ibl::prefilter
 /// The fast filter (bake/prefilter_fast.hpp) at the same samples per texel and the same
 /// nearest-level reads as the FIS sweep: the error-vs-time frontier of the two side by side.
 void BM_prefilter_fast(benchmark::State& state) { run_sweep(state, ibl::prefilter_method::fast); }
+
+/// The fast filter with and without its peak split (bake/prefilter_peaks.hpp), nearest reads,
+/// range(1) samples at level 1 doubled per level (the default schedule's shape), at face size
+/// range(3) (256 or 128): the real-time end of the frontier. args: env, spp, peaks, size.
+void BM_prefilter_fast_split(benchmark::State& state) {
+    ibl::prefilter_options o;
+    o.levels = levels;
+    o.method = ibl::prefilter_method::fast;
+    for (int l = 0; l < levels; ++l) o.samples_per_level.push_back(std::uint32_t(state.range(1)) << (l > 0 ? l - 1 : 0));
+    o.peaks.enabled = state.range(2) != 0;
+    run_chain(state, o, int(state.range(0)), int(state.range(3)));
+}
 
 /// The default schedules at the sweeps' `levels` levels (the references' roughness per level):
 /// FIS (bias 0.5, trilinear reads, 512 samples at level 1 doubled per level) and the fast filter
@@ -244,6 +258,11 @@ BENCHMARK(BM_prefilter_fast)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_prefilter_fast_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_prefilter_fast_split)
+    ->ArgNames({"env", "spp", "peaks", "size"})
+    ->ArgsProduct({{1}, {4, 8, 16, 32, 64}, {0, 1}, {128, 256}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 BENCHMARK(BM_prefilter_is)
     ->ArgNames({"env", "spp"})
     ->ArgsProduct({{0, 1}, {64, 256, 1024}})

@@ -405,15 +405,14 @@ public:
                 peaks_ = std::move(split.peaks);
                 mean_ = split.mean_luminance;
                 if (!peaks_.empty()) {
-                    packed_ = pack_cube(split.base);
+                    packed_ = pack_cube(split.base, ex);
                     table_source_levels_ = split.base.levels();
                     return;
                 }
             }
         }
-        packed_ = pack_cube(src);
+        packed_ = pack_cube(src, ex);
         table_source_levels_ = src.levels();
-        (void)ex;
     }
     /// The taps of a plan level (tables from the source's lod mapping) and its peaks.
     template <class Env> prefilter_cube_level level(const Env& env, const prefilter_level& lp) const {

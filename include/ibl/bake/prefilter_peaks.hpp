@@ -116,12 +116,15 @@ cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_opti
     const int n = src.size(0);
     const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
     std::vector<float> lum(count);
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y)
+    ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+        for (std::size_t row = b; row < e; ++row) {
+            const int f = int(row) / n, y = int(row) % n;
             for (int x = 0; x < n; ++x) {
                 const float l = float(luminance(src.texel(f, x, y, 0)));
                 lum[cube_texel_index(f, x, y, n)] = std::isfinite(l) && l > 0.f ? l : 0.f;
             }
+        }
+    });
     // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
     // so a chain down to 1 x 1 gives it in six reads; otherwise level 0 by texel solid angles.
     double acc = 0.0;

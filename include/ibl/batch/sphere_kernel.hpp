@@ -28,6 +28,7 @@
 #include <cstddef>
 #include <vector>
 
+#include "../core/executor.hpp"
 #include "../core/frame.hpp"
 #include "../core/math.hpp"
 #include "../core/vec.hpp"
@@ -55,7 +56,9 @@ struct packed_cube {
     std::vector<float> data; ///< 4 floats per texel
 };
 
-template <class T> packed_cube pack_cube(const cubemap<T>& c) {
+/// The packed copy of c; the face rows of every level are copied through the executor (a plain
+/// copy: the result does not depend on it).
+template <class T, class Executor = serial_executor> packed_cube pack_cube(const cubemap<T>& c, Executor&& ex = Executor{}) {
     IBL_ASSERT(c.borders_valid());
     packed_cube p;
     std::size_t total = 0;
@@ -70,18 +73,23 @@ template <class T> packed_cube pack_cube(const cubemap<T>& c) {
         p.levels.push_back(li);
     }
     p.data.assign(4 * total, 0.f);
-    for (int l = 0; l < c.levels(); ++l) {
-        const packed_cube::level& li = p.levels[std::size_t(l)];
-        for (int f = 0; f < 6; ++f)
-            for (int y = -1; y <= li.n; ++y)
-                for (int x = -1; x <= li.n; ++x) {
-                    const vec3<T>& v = c.texel(f, x, y, l);
-                    float* q = p.data.data() +
-                               4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
-                                    std::size_t(y + 1) * std::size_t(li.stride) + std::size_t(x + 1));
-                    for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
-                }
-    }
+    // Work items: the bordered rows (n + 2 per face) of every face of every level, in order.
+    std::vector<std::size_t> first(p.levels.size() + 1, 0);
+    for (std::size_t l = 0; l < p.levels.size(); ++l) first[l + 1] = first[l] + std::size_t(6 * p.levels[l].stride);
+    ex(first.back(), [&](std::size_t b, std::size_t e) {
+        std::size_t l = 0;
+        for (std::size_t item = b; item < e; ++item) {
+            while (item >= first[l + 1]) ++l;
+            const packed_cube::level& li = p.levels[l];
+            const int f = int((item - first[l]) / std::size_t(li.stride)), y = int((item - first[l]) % std::size_t(li.stride)) - 1;
+            float* q = p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
+                                            std::size_t(y + 1) * std::size_t(li.stride));
+            for (int x = -1; x <= li.n; ++x, q += 4) {
+                const vec3<T>& v = c.texel(f, x, y, int(l));
+                for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
+            }
+        }
+    });
     return p;
 }
 
