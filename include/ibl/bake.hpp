@@ -12,6 +12,8 @@
 #include "bake/lobe_moments.hpp"
 #include "bake/plan.hpp"
 #include "bake/prefilter.hpp"
+#include "bake/prefilter_fast.hpp"
+#include "bake/prefilter_peaks.hpp" // the fast filter's peak split
 #include "bake/prefilter_update.hpp"
 #include "bake/sheen.hpp"
 #include "bake/specular_occlusion_lut.hpp"
