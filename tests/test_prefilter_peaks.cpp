@@ -219,3 +219,35 @@ TEST_CASE("peak split: merge keeps the energy; the merge mip follows the kernel'
     CHECK(ibl::peak_merge_mip(0.2, 256, 8, 6.0, 1.0 / 16.0) == 1);
     CHECK(ibl::peak_merge_mip(1.0, 256, 8, 6.0, 1.0 / 16.0) == 1 + ibl::peak_merge_mip(1.0, 128, 8, 6.0, 1.0 / 16.0));
 }
+
+TEST_CASE("peak split: the packed patch equals packing the split's base cube, bit for bit") {
+    for (const int n : {64, 32}) {
+        // Bright texels scattered over every face, on the edges and at the corners too.
+        ibl::cubemap<float> src(n);
+        src.fill(0, [&](int f, int x, int y) {
+            const unsigned h = (unsigned(f) * 73856093u) ^ (unsigned(x) * 19349663u) ^ (unsigned(y) * 83492791u);
+            const bool edge = x == 0 || y == 0 || x == n - 1 || y == n - 1;
+            const bool bright = (h % 97u) == 0u || (edge && (h % 13u) == 0u) || ((x == 0 || x == n - 1) && (y == 0 || y == n - 1));
+            return ibl::vec3<float>(bright ? 300.f + float(h % 7u) : 0.5f + 0.01f * float(h % 11u), 1.f, bright ? 200.f : 0.7f);
+        });
+        src.generate_mips();
+        ibl::peak_split_options po;
+        const ibl::cube_peak_split<float> s = ibl::split_cube_peaks(src, po);
+        REQUIRE(s.peaks.size() > 24);
+        ibl::detail::packed_cube patched = ibl::detail::pack_cube(src);
+        REQUIRE(ibl::detail::patch_packed_peaks(patched, src, s.peaks, s.threshold));
+        const ibl::detail::packed_cube want = ibl::detail::pack_cube(s.base);
+        REQUIRE(patched.data.size() == want.data.size());
+        CHECK(std::memcmp(patched.data.data(), want.data.data(), want.data.size() * sizeof(float)) == 0);
+        const ibl::detail::packed_cube plain = ibl::detail::pack_cube(src);
+        CHECK(std::memcmp(plain.data.data(), want.data.data(), want.data.size() * sizeof(float)) != 0);
+    }
+    // A chain whose mips do not nest (face 6 -> 3 -> 1) is refused: the prefilter packs the base cube.
+    ibl::cubemap<float> odd(6);
+    odd.fill(0, [](int f, int x, int y) { return ibl::vec3<float>(f == 1 && x == 2 && y == 3 ? 1e4f : 1.f); });
+    odd.generate_mips();
+    const ibl::cube_peak_split<float> so = ibl::split_cube_peaks(odd, ibl::peak_split_options{});
+    REQUIRE(!so.empty());
+    ibl::detail::packed_cube po = ibl::detail::pack_cube(odd);
+    CHECK_FALSE(ibl::detail::patch_packed_peaks(po, odd, so.peaks, so.threshold));
+}

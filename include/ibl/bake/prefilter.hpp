@@ -401,12 +401,16 @@ public:
     prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, Executor& ex) : opt_(opt), n0_(src.size(0)) {
         if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
             if (opt.method == prefilter_method::fast && opt.peaks.enabled) {
-                cube_peak_split<T> split = split_cube_peaks(src, opt.peaks, ex);
+                cube_peak_split<T> split = find_cube_peaks(src, opt.peaks, ex);
                 peaks_ = std::move(split.peaks);
                 mean_ = split.mean_luminance;
                 if (!peaks_.empty()) {
-                    packed_ = pack_cube(split.base, ex);
-                    table_source_levels_ = split.base.levels();
+                    table_source_levels_ = src.levels();
+                    if constexpr (std::is_same_v<T, float>) { // the base patched into the packed source
+                        packed_ = pack_cube(src, ex);
+                        if (patch_packed_peaks(packed_, src, peaks_, split.threshold)) return;
+                    }
+                    packed_ = pack_cube(split_cube_peaks(src, opt.peaks, ex).base, ex);
                     return;
                 }
             }
@@ -471,17 +475,20 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
         for (int k = 0; k < int(plan.size()); ++k) {
             const prefilter_level& lp = plan[std::size_t(k)];
             const int n = out.size(k);
-            std::vector<vec3<float>> texels;
+            // The rows are written in place: each work item owns whole face rows of the output.
+            std::vector<vec3<float>*> rows(std::size_t(6 * n));
+            for (int r = 0; r < 6 * n; ++r) rows[std::size_t(r)] = &out.texel_ref(r / n, 0, r % n, k);
             if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
-                texels = detail::prefilter_base(env, n, lp.trilinear, ex);
+                const detail::prefilter_base_read m = detail::prefilter_base_mode(env, n, lp.trilinear);
+                ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+                    for (std::size_t row = b; row < e; ++row) detail::prefilter_base_row(env, n, m, row, rows[row]);
+                });
             } else {
                 const detail::prefilter_cube_level lv = cs.level(env, lp);
-                texels.resize(std::size_t(6) * std::size_t(n) * std::size_t(n));
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, texels.data() + row * std::size_t(n));
+                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row]);
                 });
             }
-            out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
         }
         out.update_borders();
         return specular_chain(std::move(out), opt.weight, opt.policy.mapping);

@@ -53,10 +53,12 @@
 #include <tuple>
 #include <vector>
 
+#include "../batch/sphere_kernel.hpp"
 #include "../brdf/ggx.hpp"
 #include "../core/color.hpp"
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
+#include "../core/math.hpp"
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
 #include "../env/cubemap.hpp"
@@ -90,6 +92,7 @@ struct cube_peak {
     vec3<float> dir{0.f, 0.f, 1.f};
     vec3<double> energy{0.0};
     double weight = 0.0; ///< the luminance energy behind dir (the merge's centroid weight)
+    float luminance = 0.f; ///< the level-0 texel's luminance (split peaks; the base keeps threshold / luminance of it)
     int face = 0, x = 0, y = 0;
 };
 
@@ -109,8 +112,17 @@ template <class T> struct cube_peak_split {
 /// above ratio times the mean, a copy of the source, and the mips patched where peaks were taken
 /// out: a level whose face is half its finer level's (the box filter nests) loses, per texel,
 /// the peaks' energy over its exact solid angle; any other chain is rebuilt (generate_mips).
-template <class T, class Executor = serial_executor>
-cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_options& opt, Executor&& ex = Executor{}) {
+namespace detail {
+/// True when every level's face is half its finer level's (the box-filter mips nest).
+template <class T> bool peak_mips_nest(const cubemap<T>& src) noexcept {
+    for (int l = 1; l < src.levels(); ++l)
+        if (src.size(l - 1) != 2 * src.size(l)) return false;
+    return true;
+}
+
+/// The peaks and the threshold of split_cube_peaks, without the base.
+template <class T, class Executor>
+cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_options& opt, Executor& ex) {
     cube_peak_split<T> s;
     if (!opt.enabled) return s;
     const int n = src.size(0);
@@ -163,18 +175,35 @@ cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_opti
                 p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
                 p.energy = v * ((1.0 - t / double(l)) * om);
                 p.weight = (double(l) - t) * om;
+                p.luminance = l;
                 p.face = f, p.x = x, p.y = y;
                 s.peaks.push_back(p);
             }
+    return s;
+}
+} // namespace detail
+
+/// Splits a cubemap source (with its mip chain) at T = max(ratio mean, the (max_peaks + 1)-th
+/// brightest luminance). With no texel above T the base is left empty (base.size() == 1 and no
+/// peaks): the caller reads the source itself. Non-finite texels count as 0.
+///
+/// Cost: one pass over level 0 (luminance), a selection only when more than max_peaks texels are
+/// above ratio times the mean, a copy of the source, and the mips patched where peaks were taken
+/// out: a level whose face is half its finer level's (the box filter nests) loses, per texel,
+/// the peaks' energy over its exact solid angle; any other chain is rebuilt (generate_mips).
+/// (prefilter patches its packed copy of the source the same way instead of copying the cube:
+/// detail::patch_packed_peaks.)
+template <class T, class Executor = serial_executor>
+cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_options& opt, Executor&& ex = Executor{}) {
+    cube_peak_split<T> s = detail::find_cube_peaks(src, opt, ex);
     if (s.peaks.empty()) return s;
+    const double t = s.threshold;
     s.base = src;
     for (const cube_peak& p : s.peaks) {
         vec3<T>& v = s.base.texel_ref(p.face, p.x, p.y, 0);
-        v = vec3<T>(vec3<double>(v) * (t / double(lum[cube_texel_index(p.face, p.x, p.y, n)])));
+        v = vec3<T>(vec3<double>(v) * (t / double(p.luminance)));
     }
-    bool nested = true;
-    for (int l = 1; l < src.levels(); ++l) nested = nested && src.size(l - 1) == 2 * src.size(l);
-    if (!nested) {
+    if (!detail::peak_mips_nest(src)) {
         s.base.generate_mips(ex);
         return s;
     }
@@ -190,6 +219,62 @@ cube_peak_split<T> split_cube_peaks(const cubemap<T>& src, const peak_split_opti
     s.base.update_borders();
     return s;
 }
+
+namespace detail {
+
+/// The base of a float source's split written into its packed copy (pack_cube(src)): the same
+/// texels, by the same operations, as pack_cube(split_cube_peaks(src).base), without copying
+/// the cube: the patched interior texels, the border texels that copy them, and the face
+/// corners. Returns false (nothing written) when the mips do not nest.
+inline bool patch_packed_peaks(packed_cube& p, const cubemap<float>& src, const std::vector<cube_peak>& peaks, double t) {
+    if (!peak_mips_nest(src) || int(p.levels.size()) != src.levels()) return false;
+    std::vector<std::uint8_t> mark;
+    for (int l = 0; l < src.levels(); ++l) {
+        const packed_cube::level& li = p.levels[std::size_t(l)];
+        const int n = li.n;
+        auto at = [&](int f, int x, int y) {
+            return p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
+                                        std::size_t(y + 1) * std::size_t(li.stride) + std::size_t(x + 1));
+        };
+        mark.assign(std::size_t(6) * std::size_t(n) * std::size_t(n), 0);
+        for (const cube_peak& pk : peaks) {
+            const int x = pk.x >> l, y = pk.y >> l;
+            float* q = at(pk.face, x, y);
+            const vec3<float> v(q[0], q[1], q[2]);
+            vec3<float> w;
+            if (l == 0) w = vec3<float>(vec3<double>(v) * (t / double(pk.luminance)));
+            else w = vec3<float>(max(vec3<double>(v) - pk.energy / cube_texel_solid_angle<double>(x, y, n), vec3<double>(0.0)));
+            for (int k = 0; k < 3; ++k) q[k] = is_finite(w[k]) ? w[k] : 0.f;
+            mark[cube_texel_index(pk.face, x, y, n)] = 1;
+        }
+        for (int f = 0; f < 6; ++f) {
+            for (int i = 0; i < n; ++i) {
+                const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
+                for (int e = 0; e < 4; ++e) {
+                    int g, gx, gy;
+                    cubemap<float>::border_source(f, xs[e], ys[e], n, g, gx, gy);
+                    if (!mark[cube_texel_index(g, gx, gy, n)]) continue;
+                    const float* from = at(g, gx, gy);
+                    float* to = at(f, xs[e], ys[e]);
+                    for (int k = 0; k < 3; ++k) to[k] = from[k];
+                }
+            }
+            const int cx[2] = {-1, n}, ix[2] = {0, n - 1};
+            for (int u = 0; u < 2; ++u)
+                for (int v = 0; v < 2; ++v) {
+                    const float* a = at(f, ix[u], ix[v]);
+                    const float* b = at(f, cx[u], ix[v]);
+                    const float* c = at(f, ix[u], cx[v]);
+                    const vec3<float> va(a[0], a[1], a[2]), vb(b[0], b[1], b[2]), vc(c[0], c[1], c[2]);
+                    const vec3<float> corner = va + ((vb - va) + (vc - va)) / 3.f;
+                    float* q = at(f, cx[u], cx[v]);
+                    for (int k = 0; k < 3; ++k) q[k] = is_finite(corner[k]) ? corner[k] : 0.f;
+                }
+        }
+    }
+    return true;
+}
+} // namespace detail
 
 /// The peaks merged into the texels of source mip m (face size n >> m): summed energy at the
 /// luminance-energy centroid, in face, row, column order of the merged texels.

@@ -239,6 +239,12 @@ public:
         update_borders();
     }
 
+    /// The interior texel (g, gx, gy) that border texel (x, y) of `face` of an n x n level copies
+    /// (update_borders; exactly one of x, y outside [0, n)).
+    static void border_source(int face, int x, int y, int n, int& g, int& gx, int& gy) noexcept {
+        fold_border(face, x, y, n, g, gx, gy);
+    }
+
     /// Rebuilds the 1-texel borders of every face of every level from the interiors.
     void update_borders() {
         for (int l = 0; l < levels(); ++l) build_borders(l);
