@@ -128,6 +128,37 @@ float ibl_corrected_roughness(float roughness, ibl_parallax_lookup l) {
     return ibl_corrected_roughness(roughness, l.d_shading, l.d_probe, l.cos_shading, l.cos_probe);
 }
 
+// The lobe split (local_probe.hpp): IBL_PARALLAX_SPLIT_TAPS sub-lobes of roughness r / sqrt 2, weight
+// 1 / 5 each, one along R and four on a ring at 2 atan(r^2 / 2) around it, each corrected on its
+// own. Tap i's reflection direction (r unit), then tap i's lookup as (direction, roughness); the
+// caller sums 0.2 x lookup over i = 0..4.
+#define IBL_PARALLAX_SPLIT_TAPS 5
+vec3 ibl_parallax_split_direction(vec3 r, float roughness, int i) {
+    if (i <= 0) return r;
+    float rr = clamp(roughness, 0.0, 1.0), q = 0.5 * rr * rr, q2 = q * q;
+    float ct = (1.0 - q2) / (1.0 + q2), st = 2.0 * q / (1.0 + q2);
+    float sg = r.z >= 0.0 ? 1.0 : -1.0, a = -1.0 / (sg + r.z), b = r.x * r.y * a;
+    vec3 t = vec3(1.0 + sg * r.x * r.x * a, sg * b, -sg * r.x), bt = vec3(b, sg + r.y * r.y * a, -r.y);
+    vec3 side = i == 1 ? t : (i == 2 ? bt : (i == 3 ? -t : -bt));
+    return ct * r + st * side;
+}
+
+vec4 ibl_parallax_split_tap_box(ibl_probe_box b, vec3 c, vec3 p, vec3 r, float roughness, int i) {
+    float len2 = dot(r, r);
+    if (!(len2 > 0.0)) return vec4(r, clamp(roughness, 0.0, 1.0));
+    float rr = clamp(roughness, 0.0, 1.0);
+    ibl_parallax_lookup l = ibl_parallax_box(b, c, p, ibl_parallax_split_direction(r * inversesqrt(len2), rr, i));
+    return vec4(l.direction, ibl_corrected_roughness(rr * sqrt(0.5), l));
+}
+
+vec4 ibl_parallax_split_tap_sphere(vec3 center, float radius, vec3 c, vec3 p, vec3 r, float roughness, int i) {
+    float len2 = dot(r, r);
+    if (!(len2 > 0.0)) return vec4(r, clamp(roughness, 0.0, 1.0));
+    float rr = clamp(roughness, 0.0, 1.0);
+    ibl_parallax_lookup l = ibl_parallax_sphere(center, radius, c, p, ibl_parallax_split_direction(r * inversesqrt(len2), rr, i));
+    return vec4(l.direction, ibl_corrected_roughness(rr * sqrt(0.5), l));
+}
+
 // Influence weights: distance to the boundary inside the volume over the fade width, in [0, 1].
 float ibl_influence_box(ibl_probe_box b, float fade, vec3 p) {
     vec3 d = b.half_extent - abs(ibl_probe_box_local(b, p - b.center));

@@ -37,6 +37,21 @@
 // (alpha -> 1) keep the clamp to [0, 1], and a zero cosine on one side sends alpha' to 0 or 1.
 // Measured in docs/local_probes.md: it lowers the single probe's glossy error at every roughness
 // of the empty room's study against the distance-only form.
+// Wide lobes (the lobe split, an option). The factor above is the map's first order: exact for a
+// narrow lobe, while a wide one (r -> 1) covers walls at many distances and slopes around the hit.
+// The split reads the lobe as five narrower sub-lobes, each corrected on its own (its own hit,
+// distances and slopes): sub-lobes of alpha / 2 (roughness r / sqrt 2), one along R and four on a
+// ring around it at the reflected angle theta = 2 atan(alpha / 2) (the GGX lobe of alpha / 2 puts
+// half its half vectors within atan(alpha / 2) of the normal), in the directions +-t, +-b of a
+// branchless tangent frame of R (Duff et al. 2017), weights 1/5 each:
+//   parallax_split_tap(proxy, C, P, R, r, i), i = 0..4 -> {direction, roughness, weight = 1/5}
+//                         tap i's lookup; the caller sums weight x lookup(direction, roughness).
+// cos theta = (1 - q^2) / (1 + q^2), sin theta = 2 q / (1 + q^2) with q = alpha / 2. Contract: the
+// weights sum to 1; r = 0 gives five copies of the mirror lookup (parallax_correct's direction,
+// roughness 0); without a hit each tap is its own direction at r / sqrt 2 (the split of a distant
+// lookup, not the single lookup itself). The sub-lobe roughness and the ring's angle were chosen
+// on a small grid of the empty room's study (docs/local_probes.md), not derived: a five-tap
+// quadrature of the lobe, costing five proxy intersections and five reads.
 // Influence volumes. Each probe has an influence box or sphere and a fade width f > 0: its weight
 // at P is the distance from P to the volume's boundary inside the volume over f, clamped to [0, 1]
 // (0 outside and on the boundary, 1 deeper than f). The weight is continuous and changes by at
@@ -231,6 +246,44 @@ template <class T> IBL_FUNC T corrected_roughness(T roughness, T d_shading, T d_
 /// The same from a parallax_lookup (its distances and cosines): the library's glossy default.
 template <class T> IBL_FUNC T corrected_roughness(T roughness, const parallax_lookup<T>& l) noexcept {
     return corrected_roughness(roughness, l.d_shading, l.d_probe, l.cos_shading, l.cos_probe);
+}
+
+/// The lobe split (see the header comment): tap i (0..4) of parallax_split_taps.
+inline constexpr int parallax_split_taps = 5;
+
+template <class T> struct parallax_tap {
+    vec3<T> direction;
+    T roughness = T(0);
+    T weight = T(0);
+};
+
+/// The reflection direction of tap i (clamped to 0..4) for the unit direction r and roughness.
+template <class T> IBL_FUNC vec3<T> parallax_split_direction(const vec3<T>& r, T roughness, int i) noexcept {
+    if (i <= 0) return r;
+    const T rr = saturate(roughness), q = T(0.5) * rr * rr, q2 = q * q;
+    const T ct = (T(1) - q2) / (T(1) + q2), st = T(2) * q / (T(1) + q2);
+    const T sg = r.z >= T(0) ? T(1) : T(-1), a = T(-1) / (sg + r.z), b = r.x * r.y * a;
+    const vec3<T> t(T(1) + sg * r.x * r.x * a, sg * b, -sg * r.x), bt(b, sg + r.y * r.y * a, -r.y);
+    const vec3<T> side = i == 1 ? t : i == 2 ? bt : i == 3 ? -t : -bt;
+    return ct * r + st * side;
+}
+
+template <class T, class Proxy>
+IBL_FUNC parallax_tap<T> parallax_split_tap(const Proxy& proxy, const vec3<T>& c, const vec3<T>& p, const vec3<T>& r, T roughness,
+                                            int i) noexcept {
+    parallax_tap<T> out;
+    out.weight = T(1) / T(parallax_split_taps);
+    vec3<T> ru = r;
+    if (!detail::unit_or_zero(ru)) {
+        out.direction = r;
+        out.roughness = saturate(roughness);
+        return out;
+    }
+    const T rr = saturate(roughness);
+    const parallax_lookup<T> l = parallax_correct(proxy, c, p, parallax_split_direction(ru, rr, i));
+    out.direction = l.direction;
+    out.roughness = corrected_roughness(rr * std::sqrt(T(0.5)), l);
+    return out;
 }
 
 /// An influence volume's weight at p: the distance from p to the boundary inside it over the fade
