@@ -13,8 +13,11 @@
 // Estimates:
 //   none       one probe at the room's centre, looked up at R and r (a distant-environment lookup)
 //   box        the same probe, parallax-corrected direction against the room's box
-//   box + r    and the distance-based roughness
-//   two probes two captures at (-2, 1.5, 0) and (2, 1.5, 2), each corrected (box + r), blended by
+//   box + r    and the distance-based roughness, distance only (alpha' = alpha d_s / d_p)
+//   oblique    and the default: the distances and the proxy's slope at the hit (alpha' = alpha
+//              (d_s / d_p) sqrt(cos_p / cos_s), corrected_roughness(r, parallax_lookup))
+//   split      the lobe split (an option): five sub-lobes, each corrected (parallax_split_tap)
+//   two probes two captures at (-2, 1.5, 0) and (2, 1.5, 2), each corrected (oblique), blended by
 //              influence boxes that split the room at x = 0 with 1 m fades (blend_probe_weights)
 // Error: relative RMSE of luminance over the points x directions (floor 1e-3 x the mean truth).
 //
@@ -98,9 +101,19 @@ void study(const ibl::analytic_room<double>& room, int n) {
     const auto lookup = [](const probe& pr, const dvec3& d, double r) {
         return dvec3(ibl::specular_lookup(pr.chain, fvec3(d), float(r)));
     };
-    const auto corrected = [&](const probe& pr, const dvec3& p, const dvec3& R, double r, bool rough) {
+    // rough: 0 the probe's roughness, 1 distance only, 2 the default (distances and slopes)
+    const auto corrected = [&](const probe& pr, const dvec3& p, const dvec3& R, double r, int rough) {
         const ibl::parallax_lookup<double> l = ibl::parallax_correct(proxy, pr.at, p, R);
-        return lookup(pr, l.direction, rough ? ibl::corrected_roughness(r, l.d_shading, l.d_probe) : r);
+        return lookup(pr, l.direction,
+                      rough == 2 ? ibl::corrected_roughness(r, l) : rough == 1 ? ibl::corrected_roughness(r, l.d_shading, l.d_probe) : r);
+    };
+    const auto split = [&](const probe& pr, const dvec3& p, const dvec3& R, double r) {
+        dvec3 sum(0.0);
+        for (int i = 0; i < ibl::parallax_split_taps; ++i) {
+            const ibl::parallax_tap<double> t = ibl::parallax_split_tap(proxy, pr.at, p, R, r, i);
+            sum += t.weight * lookup(pr, t.direction, t.roughness);
+        }
+        return sum;
     };
     const auto blended = [&](const dvec3& p, auto&& per_probe) {
         const double w[2] = {ibl::influence_weight(infl_a, fade, p), ibl::influence_weight(infl_b, fade, p)};
@@ -111,19 +124,21 @@ void study(const ibl::analytic_room<double>& room, int n) {
     };
 
     std::printf("faces %d^2, %zu points x %d directions\n\n", n, points.size(), nd);
-    std::printf("| roughness | none | box | box + r | two probes (box + r, blended) |\n|---|---|---|---|---|\n");
+    std::printf("| roughness | none | box | box + r (distance) | box + r (oblique) | split (5 taps) | two probes (oblique, blended) |\n|---|---|---|---|---|---|---|\n");
     const double roughness[] = {0.0, 0.1, 0.2, 0.4, 0.6, 0.8};
     for (double r : roughness) {
-        std::vector<double> truth, est[4];
+        std::vector<double> truth, est[6];
         for (const dvec3& p : points) {
             const ibl::room_view<double> view{&room, p};
             for (const dvec3& R : dirs) {
                 const dvec3 t = r == 0.0 ? room.trace(p, R) : ibl::reference_ld(view, R, r, 4096);
                 truth.push_back(lum(t));
                 est[0].push_back(lum(lookup(p0, R, r)));
-                est[1].push_back(lum(corrected(p0, p, R, r, false)));
-                est[2].push_back(lum(corrected(p0, p, R, r, true)));
-                est[3].push_back(lum(blended(p, [&](const probe& q) { return corrected(q, p, R, r, true); })));
+                est[1].push_back(lum(corrected(p0, p, R, r, 0)));
+                est[2].push_back(lum(corrected(p0, p, R, r, 1)));
+                est[3].push_back(lum(corrected(p0, p, R, r, 2)));
+                est[4].push_back(lum(split(p0, p, R, r)));
+                est[5].push_back(lum(blended(p, [&](const probe& q) { return corrected(q, p, R, r, 2); })));
             }
         }
         double mean = 0.0;

@@ -1,7 +1,10 @@
 // tests/test_local_probe.cpp — runtime/local_probe.hpp: ray-proxy exits against brute-force
 // marching and closed forms (axis-aligned and oriented boxes, spheres), the parallax-corrected
 // direction against the geometry it stands for (the ray from the capture point along it meets the
-// proxy where the reflection ray does), the distance-based roughness' limits and monotonicity,
+// proxy where the reflection ray does), the distance-based roughness' limits and monotonicity, its
+// oblique-wall form (closed form, limits, and the cosines against finite differences of the lookup
+// map's solid-angle scale), the lobe split's taps (closed forms, from the capture point, mirrors;
+// in the analytic room below the single lookup at r = 0.4 and 0.8),
 // influence weights (range, zero outside, Lipschitz bound 1 / fade), and the blend (contributions
 // and fallback sum to one, priorities, continuity along paths).
 
@@ -138,6 +141,95 @@ TEST_CASE("local probe: distance-based roughness") {
         const double r = ibl::corrected_roughness(0.3, 0.1 * k, 2.0);
         CHECK(r >= prev);
         prev = r;
+    }
+}
+
+TEST_CASE("local probe: roughness on oblique walls, closed form and limits") {
+    // alpha' = alpha (d_s / d_p) sqrt(cos_p / cos_s)
+    CHECK(ibl::corrected_roughness(0.4, 1.0, 4.0, 0.5, 0.5) == doctest::Approx(0.2).epsilon(1e-15)); // equal slopes: distance only
+    CHECK(ibl::corrected_roughness(0.4, 2.0, 2.0, 1.0, 0.25) == doctest::Approx(0.4 * std::sqrt(0.5)).epsilon(1e-15));
+    CHECK(ibl::corrected_roughness(0.4, 2.0, 2.0, 0.25, 1.0) == doctest::Approx(0.4 * std::sqrt(2.0)).epsilon(1e-15));
+    CHECK(ibl::corrected_roughness(0.5, 1.0, 2.0, 0.0, 0.0) == doctest::Approx(ibl::corrected_roughness(0.5, 1.0, 2.0)).epsilon(1e-15));
+    CHECK(ibl::corrected_roughness(0.5, 1.0, 2.0, 0.0, 0.3) == 1.0); // P grazing: the widest lobe
+    CHECK(ibl::corrected_roughness(0.5, 1.0, 2.0, 0.3, 0.0) == 0.0); // C grazing: a mirror
+    CHECK(ibl::corrected_roughness(0.0, 1.0, 2.0, 0.0, 0.3) == 0.0); // a mirror stays one
+    CHECK(ibl::corrected_roughness(0.5, 0.0, 1.0, 0.2, 0.9) == 0.5); // no hit: unchanged
+    CHECK(ibl::corrected_roughness(0.9, 10.0, 1.0, 0.5, 1.0) == 1.0); // clamped
+    const ibl::parallax_lookup<double> none{};
+    CHECK(ibl::corrected_roughness(0.3, none) == 0.3);
+}
+
+TEST_CASE("local probe: the cosines make the roughness correction the solid-angle Jacobian of the lookup map") {
+    // The map from P's reflection directions to C's lookup directions scales solid angle by
+    // (d_s / d_p)^2 cos_p / cos_s; measured here by finite differences of parallax_direction.
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-0.9, 0.9);
+    const auto room = ibl::probe_box<double>::axis_aligned(dvec3(-4, 0, -3), dvec3(4, 3, 5));
+    const ibl::probe_sphere<double> ball{dvec3(0.2, 1.0, -0.3), 7.0};
+    const dvec3 c(0.5, 1.5, 0.2);
+    int checked = 0;
+    for (int k = 0; k < 400; ++k) {
+        const dvec3 p = room.center + dvec3(u(rng) * room.half.x, u(rng) * room.half.y, u(rng) * room.half.z);
+        const dvec3 r = random_unit(rng);
+        const auto one = [&](const auto& proxy) {
+            const ibl::parallax_lookup<double> l = ibl::parallax_correct(proxy, c, p, r);
+            REQUIRE(l.hit);
+            if (l.cos_shading < 0.2 || l.cos_probe < 0.2) return; // near edges of the box's faces the map folds
+            dvec3 t = glm::normalize(glm::cross(r, std::fabs(r.x) < 0.9 ? dvec3(1, 0, 0) : dvec3(0, 1, 0)));
+            const dvec3 b = glm::cross(r, t);
+            const double e = 1e-6;
+            const dvec3 r1 = glm::normalize(r + e * t), r2 = glm::normalize(r + e * b);
+            const ibl::parallax_lookup<double> l1 = ibl::parallax_correct(proxy, c, p, r1), l2 = ibl::parallax_correct(proxy, c, p, r2);
+            // the same face for the three rays
+            if (glm::length(ibl::proxy_normal(proxy, p + l.d_shading * r) - ibl::proxy_normal(proxy, p + l1.d_shading * r1)) > 0.0 ||
+                glm::length(ibl::proxy_normal(proxy, p + l.d_shading * r) - ibl::proxy_normal(proxy, p + l2.d_shading * r2)) > 0.0)
+                return;
+            const double w = glm::length(glm::cross(r1 - r, r2 - r));
+            const double wp = glm::length(glm::cross(l1.direction - l.direction, l2.direction - l.direction));
+            const double q = l.d_shading / l.d_probe;
+            CHECK(wp / w == doctest::Approx(q * q * l.cos_probe / l.cos_shading).epsilon(1e-4));
+            const double a = 0.3 * 0.3, expect = std::sqrt(std::min(1.0, a * std::sqrt(wp / w)));
+            CHECK(ibl::corrected_roughness(0.3, l) == doctest::Approx(expect).epsilon(1e-4));
+            ++checked;
+        };
+        one(room);
+        one(ball);
+    }
+    CHECK(checked > 300);
+}
+
+TEST_CASE("local probe: the lobe split's taps (closed forms, P = C, mirrors)") {
+    std::mt19937_64 rng(5);
+    const auto room = ibl::probe_box<double>::axis_aligned(dvec3(-4, 0, -3), dvec3(4, 3, 5));
+    const dvec3 c(0.5, 1.5, 0.2);
+    for (int k = 0; k < 200; ++k) {
+        const dvec3 r = random_unit(rng);
+        const double rough = 0.1 + 0.9 * double(k) / 199.0, alpha = rough * rough, q = alpha / 2.0;
+        double wsum = 0.0;
+        dvec3 ring(0.0);
+        for (int i = 0; i < ibl::parallax_split_taps; ++i) {
+            const dvec3 w = ibl::parallax_split_direction(r, rough, i);
+            CHECK(glm::length(w) == doctest::Approx(1.0).epsilon(1e-12));
+            // the ring at the reflected angle 2 atan(alpha / 2) around R
+            CHECK(std::acos(std::clamp(glm::dot(w, r), -1.0, 1.0)) == doctest::Approx(i == 0 ? 0.0 : 2.0 * std::atan(q)).epsilon(1e-6));
+            if (i > 0) ring += w;
+            // from the capture point: the tap's own direction at r / sqrt 2
+            const ibl::parallax_tap<double> t = ibl::parallax_split_tap(room, c, c, r, rough, i);
+            CHECK(glm::length(t.direction - w) < 1e-12);
+            CHECK(t.roughness == doctest::Approx(rough / std::sqrt(2.0)).epsilon(1e-12));
+            wsum += t.weight;
+        }
+        CHECK(wsum == doctest::Approx(1.0).epsilon(1e-15));
+        // opposite ring taps: the ring's mean lies on R at cos(theta) = (1 - q^2) / (1 + q^2)
+        CHECK(glm::length(ring / 4.0 - r * ((1.0 - q * q) / (1.0 + q * q))) < 1e-12);
+    }
+    // a mirror: five copies of the corrected mirror lookup
+    const dvec3 p(-2.0, 0.7, 3.1), r = glm::normalize(dvec3(0.3, -0.4, 0.8));
+    const ibl::parallax_lookup<double> l = ibl::parallax_correct(room, c, p, r);
+    for (int i = 0; i < ibl::parallax_split_taps; ++i) {
+        const ibl::parallax_tap<double> t = ibl::parallax_split_tap(room, c, p, r, 0.0, i);
+        CHECK(glm::length(t.direction - l.direction) < 1e-15);
+        CHECK(t.roughness == 0.0);
     }
 }
 
@@ -297,7 +389,7 @@ TEST_CASE("analytic room, inner-box variant: rays stop at the block, the rest of
     CHECK(missed > 100);
 }
 
-TEST_CASE("local probes in the analytic room: parallax correction and distance-based roughness cut the error") {
+TEST_CASE("local probes in the analytic room: parallax correction and distance-based roughness cut the error; the slopes and the lobe split cut it further") {
     // Small and fast (64^2 captures, 12 points x 8 directions, 1024-sample references); the full
     // study with its figures is research/local_probe_error (docs/local_probes.md).
     const ibl::analytic_room<double> room;
@@ -313,10 +405,10 @@ TEST_CASE("local probes in the analytic room: parallax correction and distance-b
         const double z = 1.0 - (2.0 * k + 1.0) / 8.0, ph = 2.399963229728653 * k, s = std::sqrt(1.0 - z * z);
         dirs.push_back(dvec3(s * std::cos(ph), z, s * std::sin(ph)));
     }
-    for (double r : {0.0, 0.4}) {
+    for (double r : {0.0, 0.4, 0.8}) {
         CAPTURE(r);
         double mean = 0.0;
-        std::vector<double> truth, none, fixed;
+        std::vector<double> truth, none, fixed, oblique, split;
         for (const dvec3& p : points)
             for (const dvec3& R : dirs) {
                 const ibl::room_view<double> view{&room, p};
@@ -325,14 +417,26 @@ TEST_CASE("local probes in the analytic room: parallax correction and distance-b
                 const ibl::parallax_lookup<double> l = ibl::parallax_correct(proxy, c, p, R);
                 const double rc = ibl::corrected_roughness(r, l.d_shading, l.d_probe);
                 fixed.push_back(ibl::luminance(dvec3(ibl::specular_lookup(chain, ibl::vec3<float>(l.direction), float(rc)))));
+                const double ro = ibl::corrected_roughness(r, l);
+                oblique.push_back(ibl::luminance(dvec3(ibl::specular_lookup(chain, ibl::vec3<float>(l.direction), float(ro)))));
+                dvec3 sp(0.0);
+                for (int i = 0; i < ibl::parallax_split_taps; ++i) {
+                    const ibl::parallax_tap<double> t = ibl::parallax_split_tap(proxy, c, p, R, r, i);
+                    sp += t.weight * dvec3(ibl::specular_lookup(chain, ibl::vec3<float>(t.direction), float(t.roughness)));
+                }
+                split.push_back(ibl::luminance(sp));
                 mean += truth.back();
             }
         mean /= double(truth.size());
-        ibl::error_accumulator a(1e-3 * mean), b(1e-3 * mean);
-        for (std::size_t i = 0; i < truth.size(); ++i) a.add(none[i], truth[i]), b.add(fixed[i], truth[i]);
-        const double e_none = a.finish().rel_rmse, e_fixed = b.finish().rel_rmse;
-        MESSAGE("r = " << r << ": uncorrected " << e_none << ", corrected " << e_fixed);
-        CHECK(e_fixed < 0.5 * e_none);
+        ibl::error_accumulator a(1e-3 * mean), b(1e-3 * mean), o(1e-3 * mean), q(1e-3 * mean);
+        for (std::size_t i = 0; i < truth.size(); ++i)
+            a.add(none[i], truth[i]), b.add(fixed[i], truth[i]), o.add(oblique[i], truth[i]), q.add(split[i], truth[i]);
+        const double e_none = a.finish().rel_rmse, e_fixed = b.finish().rel_rmse, e_oblique = o.finish().rel_rmse, e_split = q.finish().rel_rmse;
+        MESSAGE("r = " << r << ": uncorrected " << e_none << ", corrected " << e_fixed << ", oblique " << e_oblique << ", split " << e_split);
+        if (r > 0.0) CHECK(e_split < e_oblique);
+        if (r == 0.8) CHECK(e_split < 0.5 * e_none); // the lobe split halves the error where one tap does not
+        if (r <= 0.4) CHECK(e_fixed < 0.5 * e_none);
+        CHECK(e_oblique < e_fixed * (r == 0.0 ? 1.0 + 1e-12 : 1.0)); // the slopes' factor: no worse for mirrors, better for glossy
         if (r == 0.0) CHECK(e_fixed < 0.06); // mirror at 64^2 faces (0.5% at 256^2: docs/local_probes.md)
     }
 }

@@ -65,7 +65,8 @@ void main() {
     vec4 contrib;
     float fb = ibl_blend_probe_weights4(vec4(ibl_influence_box(pb, 0.5, u_n), ibl_influence_sphere(vec3(0.0), 4.0, 0.5, u_n), 0.5, 0.25),
                                         ivec4(1, 0, 0, 2), 4, contrib);
-    vec3 lp = pl.direction + ps.direction * ibl_corrected_roughness(u_r, pl.d_shading, pl.d_probe) +
+    vec3 lp = pl.direction + ibl_parallax_split_tap_sphere(vec3(0.0), 4.0, vec3(0.5), u_n, u_l, u_r, 2).xyz +
+              ibl_parallax_split_tap_box(pb, vec3(0.5), u_n, u_l, u_r, 1).w + ps.direction * (ibl_corrected_roughness(u_r, pl.d_shading, pl.d_probe) + ibl_corrected_roughness(u_r, ps)) +
               vec3(ibl_proxy_exit_sphere(vec3(0.0), 2.0, u_n, u_l) + fb + contrib.x + ps.d_probe);
     o_color = vec4(b + ld + a + sp + d + br + dk + t.lod + cap + rt + fis + lt + so + pf + lp, 1.0);
 }

@@ -655,7 +655,9 @@ v4 local_probe_row(int j, int i) {
     const v3 c(0.25f, 0.5f, -0.25f), p = probe_point(i), r = probe_dir(i);
     if (j == 32) {
         const ibl::parallax_lookup<float> l = ibl::parallax_correct(b, c, p, r);
-        return {l.direction.x, l.direction.y, l.direction.z, l.d_shading};
+        const ibl::parallax_tap<float> tap = ibl::parallax_split_tap(b, c, p, r, x, i % ibl::parallax_split_taps);
+        const v3 d = l.direction + 0.5f * tap.direction;
+        return {d.x, d.y, d.z, l.d_shading + tap.roughness};
     }
     const ibl::probe_sphere<float> sph{v3(0.25f, 0.0f, 0.5f), 3.0f};
     const ibl::parallax_lookup<float> s = ibl::parallax_correct(sph, c, p, r);
@@ -663,7 +665,8 @@ v4 local_probe_row(int j, int i) {
     const int pr[4] = {i % 3, 1, 0, i % 2};
     float contrib[4];
     const float fb = ibl::blend_probe_weights(w, pr, 4, contrib);
-    return {ibl::corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe, fb, contrib[0] + 2.0f * contrib[1]};
+    const float ro = ibl::corrected_roughness(x, ibl::parallax_correct(b, c, p, r)) + ibl::corrected_roughness(1.0f - x, s);
+    return {ibl::corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe + ro, fb, contrib[0] + 2.0f * contrib[1]};
 }
 
 v4 row_value(int j, int i) {

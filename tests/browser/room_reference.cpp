@@ -221,7 +221,7 @@ int main(int argc, char** argv) {
                 if (corrected) {
                     const ibl::parallax_lookup<float> l = ibl::parallax_correct(proxy, v3(pr.at), p, r);
                     dir = l.direction;
-                    rr = ibl::corrected_roughness(rough, l.d_shading, l.d_probe);
+                    rr = ibl::corrected_roughness(rough, l);
                 }
                 c += contrib[i] * ibl::specular_lookup(pr.chain, dir, rr);
             }

@@ -157,14 +157,16 @@ vec4 local_probe_row(int j, int i) {
     vec3 c = vec3(0.25, 0.5, -0.25), p = probe_point(i), r = probe_dir(i);
     if (j == 32) {
         ibl_parallax_lookup l = ibl_parallax_box(b, c, p, r);
-        return vec4(l.direction, l.d_shading);
+        vec4 tap = ibl_parallax_split_tap_box(b, c, p, r, x, i % IBL_PARALLAX_SPLIT_TAPS);
+        return vec4(l.direction + 0.5 * tap.xyz, l.d_shading + tap.w);
     }
     ibl_parallax_lookup s = ibl_parallax_sphere(vec3(0.25, 0.0, 0.5), 3.0, c, p, r);
     vec4 contrib;
     float fb = ibl_blend_probe_weights4(vec4(ibl_influence_box(b, 0.5, p), ibl_influence_sphere(vec3(0.25, 0.0, 0.5), 3.0, 0.75, p), x,
                                              1.0 - x),
                                         ivec4(i % 3, 1, 0, i % 2), 4, contrib);
-    return vec4(ibl_corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe, fb, contrib.x + 2.0 * contrib.y);
+    float ro = ibl_corrected_roughness(x, ibl_parallax_box(b, c, p, r)) + ibl_corrected_roughness(1.0 - x, s);
+    return vec4(ibl_corrected_roughness(x, s.d_shading, s.d_probe), s.d_probe + ro, fb, contrib.x + 2.0 * contrib.y);
 }
 
 vec4 row_value(int j, int i) {

@@ -38,7 +38,7 @@ vec3 probe_ld(samplerCube chain, vec3 at, ibl_probe_box proxy, vec3 p, vec3 r, f
     if (corrected) {
         ibl_parallax_lookup l = ibl_parallax_box(proxy, at, p, r);
         dir = l.direction;
-        rr = ibl_corrected_roughness(rough, l.d_shading, l.d_probe);
+        rr = ibl_corrected_roughness(rough, l);
     }
     return ibl_specular_lookup(chain, dir, rr, ibl_specular_textbook(u_levels, 0, u_levels));
 }

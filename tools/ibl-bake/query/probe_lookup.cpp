@@ -172,7 +172,7 @@ dv3 local_specular(const probe_set_folder& s, const dv3& p, const dv3& d, double
         if (!(c[i] > 0.0)) continue;
         const ibl::parallax_lookup<double> pl =
             q.proxy_sphere ? ibl::parallax_correct(q.proxy_ball, q.position, p, d) : ibl::parallax_correct(q.proxy_box, q.position, p, d);
-        const double rc = ibl::corrected_roughness(r, pl.d_shading, pl.d_probe);
+        const double rc = ibl::corrected_roughness(r, pl);
         sum += c[i] * dv3(ibl::specular_lookup(q.chain, ibl::vec3<float>(pl.direction), float(rc), s.specular));
     }
     return sum;

@@ -13,8 +13,8 @@
 // distance from P to its position; the first on ties) answers alone, without parallax correction.
 // local: each contributing probe's chain (the decoded layer of probes.ktx2) read by
 // ibl::specular_lookup with the textbook desc and the chain's mapping at
-// ibl::parallax_correct(proxy, position, P, D).direction and ibl::corrected_roughness(R,
-// d_shading, d_probe). local_irradiance: max(0, sh_evaluate(sh_irradiance_i, N)) per probe.
+// ibl::parallax_correct(proxy, position, P, D).direction and ibl::corrected_roughness(R, that
+// lookup) (its distances and the proxy's slopes at the hit). local_irradiance: max(0, sh_evaluate(sh_irradiance_i, N)) per probe.
 // The words of a single bake (specular, irradiance, ...) get an error line on a probe set.
 
 #include <array>

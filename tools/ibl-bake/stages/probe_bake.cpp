@@ -223,7 +223,7 @@ void run_probe_bake(const bake_options& opt, std::FILE* out) {
     for (const ibl::specular_level_plan& l : plan.specular.levels) j.value(l.roughness);
     j.end_array();
     j.key("parallax").value("per probe: R' = parallax_correct(proxy, position, P, R) (ibl/runtime/local_probe.hpp), roughness "
-                            "r' = corrected_roughness(r, d_shading, d_probe); no proxy hit: R and r unchanged");
+                            "r' = corrected_roughness(r, d_shading, d_probe, cos_shading, cos_probe); no proxy hit: R and r unchanged");
     j.key("blend").value("w_i = influence_weight(influence, fade, P); contributions c_i = blend_probe_weights(w, priority) "
                          "(higher priority first); a probe set has no distant environment: the c_i are divided by their "
                          "sum when it is > 0, and when every w_i is 0 the nearest probe (distance to its position) is read "

@@ -311,8 +311,8 @@ TEST_CASE("probes: local lookups blend parallax-corrected probes") {
     const auto l1 = ibl::parallax_correct(ball1, dvec3(2, 0, 0), p, d);
     REQUIRE(l0.hit);
     REQUIRE(l1.hit);
-    const dvec3 a0 = ld(0, l0.direction, ibl::corrected_roughness(r, l0.d_shading, l0.d_probe));
-    const dvec3 a1 = ld(1, l1.direction, ibl::corrected_roughness(r, l1.d_shading, l1.d_probe));
+    const dvec3 a0 = ld(0, l0.direction, ibl::corrected_roughness(r, l0));
+    const dvec3 a1 = ld(1, l1.direction, ibl::corrected_roughness(r, l1));
     const dvec3 blended = parse3(lines[2]);
     check_close(blended, a0 / 3.0 + a1 * (2.0 / 3.0), 1e-5, "blend at (0.5, 0, 0)");
     for (int c = 0; c < 3; ++c) {
@@ -376,7 +376,7 @@ TEST_CASE("probes: oriented boxes (center, half_extents, axes)") {
     const auto corrected = [&](const ibl::probe_box<double>& bx) {
         const auto l = ibl::parallax_correct(bx, c, p, d);
         REQUIRE(l.hit);
-        return dvec3(ibl::specular_lookup(layers[0], fvec3(l.direction), float(ibl::corrected_roughness(r, l.d_shading, l.d_probe)), desc));
+        return dvec3(ibl::specular_lookup(layers[0], fvec3(l.direction), float(ibl::corrected_roughness(r, l)), desc));
     };
     std::ofstream(b.s / "oq.txt") << "local -1.5 0.5 1 -0.8 0.1 0.3 0.2\n";
     REQUIRE(shell(tool + " --lookup " + out + " <" + b.s / "oq.txt" + " >" + b.s / "oa.txt" + " 2>&1") == 0);
