@@ -280,9 +280,25 @@ BAD_KINDS = ["raise", "nan", "inf", "neg", "short", "long", "2d", "str", "none",
 
 def make_model(rng):
     """A model object: good, or with one misbehaving / missing / non-callable method."""
-    k = rng.integers(0, 10)
+    k = rng.integers(0, 12)
     if k < 3:
         return GoodModel()
+    if k == 10:  # an attribute whose lookup raises
+        class Prop(GoodModel):
+            @property
+            def ndf(self):
+                raise ModelError("model failure")
+        return Prop()
+    if k == 11:  # a method returning an array subclass / a read-only view of its input
+        class Odd(GoodModel):
+            def alpha(self, r):
+                a = np.asarray(r) ** 2
+                return np.ma.masked_array(a, mask=np.zeros(a.shape, bool))
+
+            def visibility(self, n_dot_v, n_dot_l, r):
+                n_dot_v.setflags(write=False) if rng.random() < 0.5 else None
+                return np.broadcast_to(0.25, np.shape(n_dot_v))
+        return Odd()
     if k == 3:
         return object()  # no methods at all
     if k == 4:  # a method that is not callable
@@ -501,9 +517,81 @@ def g_reference_radiance(rng):
     return args, kw, {"finite": True}
 
 
+_TMP = None
+
+
+def _tmpdir():
+    global _TMP
+    if _TMP is None:
+        import tempfile
+        _TMP = tempfile.mkdtemp(prefix="ibl_fuzz_")
+    return _TMP
+
+
+def _tiny_hdr(rng, h=4, w=8):
+    """A small flat (uncompressed) Radiance RGBE file."""
+    px = rng.integers(0, 256, size=(h, w, 4), dtype=np.uint8)
+    px[..., 3] = rng.integers(100, 160, size=(h, w))
+    return b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n" + f"-Y {h} +X {w}\n".encode() + px.tobytes()
+
+
+def _mutate(rng, data):
+    """Bytes flipped, cut short or with a header field replaced."""
+    b = bytearray(data)
+    k = rng.integers(0, 5)
+    if k == 0 and b:
+        for _ in range(int(rng.integers(1, 9))):
+            b[int(rng.integers(0, len(b)))] = int(rng.integers(0, 256))
+    elif k == 1:
+        b = b[:int(rng.integers(0, len(b) + 1))]
+    elif k == 2:
+        b = b.replace(b"-Y 4 +X 8", [b"-Y 99999999 +X 99999999", b"-Y -4 +X 8", b"-Y 0 +X 0",
+                                     b"+X 8 -Y 4", b"-Y 4 +X 9999999999999999999"][rng.integers(0, 5)])
+    elif k == 3 and len(b) > 16:  # a header from a real file, its data cut off
+        b = b[:16] + bytes(rng.integers(0, 256, size=int(rng.integers(0, 256)), dtype=np.uint8))
+    return bytes(b)
+
+
+_EXR_HEAD = None
+
+
+def _exr_head():
+    """The first 64 KiB of a test EXR (header and offset table intact, data cut), when available."""
+    global _EXR_HEAD
+    if _EXR_HEAD is None:
+        _EXR_HEAD = b""
+        d = os.environ.get("IBL_TEST_DATA") or os.path.join(os.path.dirname(__file__), "..", "..", "tests", "data")
+        p = os.path.join(d, "studio.exr")
+        if os.path.exists(p):
+            with open(p, "rb") as f:
+                _EXR_HEAD = f.read(65536)
+    return _EXR_HEAD
+
+
+def _fuzz_file(rng, base, suffix):
+    path = os.path.join(_tmpdir(), f"f{rng.integers(0, 1 << 30)}{suffix}")
+    with open(path, "wb") as f:
+        f.write(_mutate(rng, base) if rng.random() < 0.8 else base)
+    return path
+
+
+KTX2_MAGIC = b"\xabKTX 20\xbb\r\n\x1a\n"
+
+
+def _tiny_ktx2(rng):
+    """The KTX2 identifier, then a header of random / extreme 32-bit fields and a little data."""
+    fields = rng.choice(np.array([0, 1, 2, 4, 6, 97, 0xFFFFFFFF, 0x7FFFFFFF, 64, 80], dtype=np.uint32), size=17)
+    return KTX2_MAGIC + fields.astype("<u4").tobytes() + bytes(rng.integers(0, 256, size=int(rng.integers(0, 512)),
+                                                                            dtype=np.uint8))
+
+
 def g_read_image(rng):
-    paths = ["/nonexistent/x.hdr", "", "/", "/dev/null", "/proc/self/status", __file__, "\0x",
-             3, None, b"/tmp"]
+    if rng.random() < 0.6:
+        base = _exr_head() if rng.random() < 0.3 else _tiny_hdr(rng)
+        paths = [_fuzz_file(rng, base or _tiny_hdr(rng), ".hdr")]
+    else:
+        paths = ["/nonexistent/x.hdr", "", "/", "/dev/null", "/proc/self/status", __file__, "\0x",
+                 3, None, b"/tmp"]
     kw = {}
     if rng.random() < 0.4:
         kw["latlong"] = gen_bool(rng)
@@ -511,10 +599,12 @@ def g_read_image(rng):
         kw["max_pixels"] = gen_int(rng, 0, 1 << 20)
     if rng.random() < 0.3:
         kw["replace_nonfinite"] = gen_bool(rng)
-    return [paths[rng.integers(0, len(paths))]], kw, {}
+    return [paths[rng.integers(0, len(paths))]], kw, {"finite": True}
 
 
 def g_read_ktx2(rng):
+    if rng.random() < 0.6:
+        return [_fuzz_file(rng, _tiny_ktx2(rng), ".ktx2")], {}, {}
     paths = ["/nonexistent/x.ktx2", "", "/", "/dev/null", __file__, 3, None]
     return [paths[rng.integers(0, len(paths))]], {}, {}
 
@@ -546,7 +636,17 @@ def g_specular_lookup(rng):
         if rng.random() < 0.1:
             chain = [c.astype(np.float64) for c in chain]
     else:
-        chain = [gen_cube(rng), hostile(rng, 3)] if rng.random() < 0.5 else hostile(rng, 3)
+        k = rng.integers(0, 5)
+        if k == 0:
+            chain = [gen_cube(rng), hostile(rng, 3)]
+        elif k == 1:
+            chain = "abc"
+        elif k == 2:
+            chain = np.ones((2, 6, 4, 4, 3), np.float32)  # an array as the sequence of levels
+        elif k == 3:
+            chain = (c for c in [np.ones((6, 4, 4, 3), np.float32)])  # a generator
+        else:
+            chain = hostile(rng, 3)
     lead = _lead(rng)
     kw = {}
     if rng.random() < 0.4:
@@ -858,7 +958,12 @@ if __name__ == "__main__":
     trace = os.environ.get("IBL_FUZZ_TRACE") == "1"
     faulthandler.dump_traceback_later(max(60, iters), exit=True)  # a hang: traceback and exit
     t0 = time.time()
-    calls, failures = run(seed, iters, only, trace)
+    try:
+        calls, failures = run(seed, iters, only, trace)
+    finally:
+        if _TMP is not None:
+            import shutil
+            shutil.rmtree(_TMP, ignore_errors=True)
     for f in failures[:40]:
         print("FAIL", f)
     print(f"seed {seed}: {calls} calls, {len(failures)} failures, {time.time() - t0:.1f} s")
