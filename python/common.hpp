@@ -83,6 +83,8 @@ template <class T> broadcast_args<T> broadcast(const char* fn, const std::vector
     std::vector<py::array> conv;
     py::list leads;
     for (const arg& a : args) {
+        if (a.obj.is_none()) // NumPy would make it NaN
+            throw py::type_error(std::string("ibl.") + fn + ": argument '" + a.name + "' is None; a real number or array is expected");
         refuse_complex(fn, a.name, a.obj);
         py::array x = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a.obj);
         if (!x) throw py::type_error(std::string("ibl.") + fn + ": argument '" + a.name + "' is not a real number array");
