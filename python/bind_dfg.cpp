@@ -114,8 +114,14 @@ constexpr std::size_t max_batch_nodes = std::size_t(1) << 16;
 
 std::string shape_str(const py::array& a) { return std::string(py::str(py::tuple(a.attr("shape")))); }
 
+/// Why a Python model's finite values can still give a non-finite integral.
+constexpr const char* model_overflow =
+    "the Python model's finite values are too large (the weights overflow), or its albedo is 0 where the "
+    "multiscatter channel divides by it";
+
 /// result of model.<fn>(...) as n float64 values (a scalar or an array broadcastable to (n,)).
 py::array_t<double> model_result(py::object r, const char* fn, std::size_t n) {
+    refuse_complex("dfg", (std::string("the result of model.") + fn).c_str(), r);
     auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
     if (!a) throw py::type_error(std::string("ibl: model.") + fn + " returned " + std::string(py::str(py::type::of(r))) +
                                  ", not a real array");
@@ -363,6 +369,7 @@ py::object dfg(py::object n_dot_v, py::object roughness, py::object model, unsig
         using T = decltype(tag);
         py::array_t<T> out = make_output<T>(b.shape, 2);
         for (std::size_t i = 0; i < 2 * n; ++i) out.mutable_data()[i] = T(ab[i]);
+        if (!ma.is_builtin) check_finite_result("dfg", out.data(), 2 * n, model_overflow);
         return out;
     };
     if (f32) return emit(float{});
@@ -475,6 +482,7 @@ py::array_t<float> dfg_lut(long long size, py::object model, const std::string& 
         });
     } else {
         lut = python_dfg_lut(python_model(ma.obj), std::uint32_t(size), layout, channels);
+        check_finite_result("dfg_lut", lut.data.data(), lut.data.size(), model_overflow);
     }
     py::array_t<float> out({py::ssize_t(size), py::ssize_t(size), py::ssize_t(channels)});
     std::copy(lut.data.begin(), lut.data.end(), out.mutable_data());
@@ -561,6 +569,7 @@ py::object dfg_mc(py::object n_dot_v, py::object roughness, long long samples, p
             const std::vector<T> ab = python_dfg_mc<T>(ma.obj, b.data[0], b.data[1], b.count, n, vndf);
             py::array_t<T> out = make_output<T>(b.shape, 2);
             std::copy(ab.begin(), ab.end(), out.mutable_data());
+            check_finite_result("dfg_mc", out.data(), ab.size(), model_overflow);
             return out;
         };
         return f32 ? emit(float{}) : emit(double{});
@@ -585,6 +594,10 @@ py::object dfg_albedo(py::object n_dot_v, py::object roughness, py::object model
         const bool f32 = all_float32({{n_dot_v, 1, "n_dot_v"}, {roughness, 1, "roughness"}});
         broadcast_args<double> b = broadcast<double>("dfg_albedo", {{n_dot_v, 1, "n_dot_v", true}, {roughness, 1, "roughness", true}});
         const std::vector<double> eb = python_dfg_eb(ma.obj, b.data[0], b.data[1], b.count);
+        for (std::size_t i = 0; i < b.count; ++i) {
+            const double e = f32 ? double(float(eb[2 * i])) : eb[2 * i];
+            check_finite_result("dfg_albedo", &e, 1, model_overflow);
+        }
         if (b.scalar) return py::float_(f32 ? double(float(eb[0])) : eb[0]);
         auto emit = [&](auto tag) -> py::object {
             using T = decltype(tag);

@@ -36,6 +36,7 @@ using cube_array = py::array_t<float, py::array::c_style | py::array::forcecast>
 
 /// The cube argument as a cubemap<float> with its full mip chain (box-filtered on the sphere).
 ibl::cubemap<float> to_cubemap(const char* fn, py::object cube, unsigned threads) {
+    refuse_complex(fn, "cube", cube);
     cube_array a = cube_array::ensure(cube);
     if (!a) throw py::type_error(std::string("ibl.") + fn + ": cube must be a real array of shape (6, n, n, 3)");
     if (a.ndim() != 4 || a.shape(0) != 6 || a.shape(1) != a.shape(2) || a.shape(3) != 3 || a.shape(1) < 1)
@@ -59,8 +60,12 @@ ibl::cubemap<float> to_cubemap(const char* fn, py::object cube, unsigned threads
     return c;
 }
 
-/// Level `level` of a cubemap as a new (6, s, s, 3) float32 array.
-py::array_t<float> level_array(const ibl::cubemap<float>& c, int level) {
+/// Why a finite cube can still give a non-finite result.
+constexpr const char* cube_overflow = "the cube's finite values are too large for float (the sums overflow); scale it down";
+
+/// Level `level` of a cubemap as a new (6, s, s, 3) float32 array; ValueError naming `fn` when a
+/// texel is not finite (`fn` null: no check).
+py::array_t<float> level_array(const ibl::cubemap<float>& c, int level, const char* fn = nullptr) {
     const int s = c.size(level);
     py::array_t<float> out({py::ssize_t(6), py::ssize_t(s), py::ssize_t(s), py::ssize_t(3)});
     float* o = out.mutable_data();
@@ -73,6 +78,7 @@ py::array_t<float> level_array(const ibl::cubemap<float>& c, int level) {
                 q[1] = t.y;
                 q[2] = t.z;
             }
+    if (fn) check_finite_result(fn, out.data(), std::size_t(out.size()), cube_overflow);
     return out;
 }
 
@@ -136,6 +142,7 @@ bool is_python_lobe(const char* fn, const py::object& model) {
 
 /// `count` float64 values from a model method's result (a scalar or shape (count,)).
 std::vector<double> model_values(const char* fn, const char* method, py::object r, std::size_t count) {
+    refuse_complex(fn, (std::string("the result of model.") + method).c_str(), r);
     auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
     if (!a) throw py::type_error(std::string("ibl.") + fn + ": model." + method + " returned " +
                                  std::string(py::str(py::type::of(r))) + ", not a real array");
@@ -242,7 +249,7 @@ py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std
         chain.emplace(ibl::prefilter(env, opt, ibl::thread_executor{threads}));
     }
     py::list out;
-    for (int l = 0; l < chain->levels(); ++l) out.append(level_array(*chain, l));
+    for (int l = 0; l < chain->levels(); ++l) out.append(level_array(*chain, l, "prefilter"));
     return out;
 }
 
@@ -261,7 +268,7 @@ py::array_t<float> irradiance(py::object cube, int size, std::uint32_t samples, 
         py::gil_scoped_release release;
         e.emplace(ibl::irradiance_cubemap(env, opt, ibl::thread_executor{threads}));
     }
-    return level_array(*e, 0);
+    return level_array(*e, 0, "irradiance");
 }
 
 py::array_t<double> sh_project(py::object cube, int bands, unsigned threads) {
@@ -274,11 +281,14 @@ py::array_t<double> sh_project(py::object cube, int bands, unsigned threads) {
             const auto c = ibl::project_cube<B>(env, ibl::thread_executor{threads});
             for (int i = 0; i < B * B; ++i) k.c[i] = ibl::vec3<double>(c.c[i]);
         }
-        return from_coeffs<B>(k);
+        py::array_t<double> out = from_coeffs<B>(k);
+        check_finite_result("sh_project", out.data(), std::size_t(out.size()), cube_overflow);
+        return out;
     });
 }
 
 py::object sh_evaluate(py::object coeffs, py::object dirs) {
+    refuse_complex("sh", "coeffs", coeffs);
     coeff_array c = coeff_array::ensure(coeffs);
     if (!c) throw py::type_error("ibl.sh_evaluate: coeffs must be a real array (bands^2, 3)");
     const int bands = coeff_bands("sh_evaluate", c);
@@ -295,6 +305,7 @@ py::object sh_evaluate(py::object coeffs, py::object dirs) {
 }
 
 py::array_t<double> sh_irradiance(py::object coeffs) {
+    refuse_complex("sh", "coeffs", coeffs);
     coeff_array c = coeff_array::ensure(coeffs);
     if (!c) throw py::type_error("ibl.sh_irradiance: coeffs must be a real array (bands^2, 3)");
     return with_bands("sh_irradiance", coeff_bands("sh_irradiance", c), [&](auto b) {
@@ -320,9 +331,13 @@ py::object reference_ld(py::object cube, py::object dirs, py::object roughness, 
     double* o = out.mutable_data();
     const double* d = b.data[0];
     const double* r = b.data[1];
-    for (std::size_t i = 0; i < b.count; ++i)
-        if (!(d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] + d[3 * i + 2] * d[3 * i + 2] > 0.0))
-            throw py::value_error("ibl.reference_ld: dirs must be non-zero finite vectors");
+    for (std::size_t i = 0; i < b.count; ++i) {
+        const double len2 = d[3 * i] * d[3 * i] + d[3 * i + 1] * d[3 * i + 1] + d[3 * i + 2] * d[3 * i + 2];
+        if (!(len2 > 0.0 && std::isfinite(len2)))
+            throw py::value_error("ibl.reference_ld: dirs must be non-zero finite vectors (squared length within "
+                                  "double's range), got one of squared length " + std::to_string(len2) +
+                                  " at index " + std::to_string(i));
+    }
     auto run = [&](auto lobe_tag) {
         using Lobe = decltype(lobe_tag);
         ibl::thread_executor{threads}(b.count, [&](std::size_t begin, std::size_t end) {
@@ -344,6 +359,7 @@ py::object reference_ld(py::object cube, py::object dirs, py::object roughness, 
         py::gil_scoped_release release;
         run(ibl::ggx_lobe{});
     }
+    check_finite_result("reference_ld", out.data(), std::size_t(out.size()), cube_overflow);
     return out;
 }
 
@@ -386,7 +402,7 @@ py::object extract_sun(py::object cube, double threshold_over_median, double thr
     light["region_solid_angle"] = double(sun.region_solid_angle);
     light["region_texels"] = sun.region_texels;
     light["share"] = sun.share;
-    return py::make_tuple(light, level_array(env, 0));
+    return py::make_tuple(light, level_array(env, 0, "extract_sun"));
 }
 
 // ---- reference_radiance of a Python model: record / replay ------------------------------------------
@@ -545,8 +561,9 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
             const std::size_t p1 = std::min(b.count, p0 + per_batch), m = p1 - p0;
             py::array_t<double> rough(static_cast<py::ssize_t>(m));
             for (std::size_t i = 0; i < m; ++i) rough.mutable_data()[i] = material(p0 + i).roughness;
-            py::array_t<double> alpha_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(
-                model.attr("alpha")(rough));
+            py::object alpha_obj = model.attr("alpha")(rough);
+            refuse_complex("reference_radiance", "the result of model.alpha", alpha_obj);
+            py::array_t<double> alpha_arr = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(alpha_obj);
             if (!alpha_arr || !(alpha_arr.ndim() == 0 || (alpha_arr.ndim() == 1 && std::size_t(alpha_arr.shape(0)) == m)))
                 throw py::value_error("ibl.reference_radiance: model.alpha must return a real scalar or an array of shape (" +
                                       std::to_string(m) + ",)");
@@ -593,6 +610,7 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
                 }
             }
             auto values = [&](py::object r, const char* fn_name) {
+                refuse_complex("reference_radiance", (std::string("the result of model.") + fn_name).c_str(), r);
                 auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(r);
                 if (!a || !(a.ndim() == 0 || (a.ndim() == 1 && std::size_t(a.shape(0)) == total)))
                     throw py::value_error(std::string("ibl.reference_radiance: model.") + fn_name +
@@ -631,6 +649,8 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
         py::array_t<double> a = make_output<double>(b.shape, 3);
         std::copy(out.begin() + std::ptrdiff_t(p * b.count * 3), out.begin() + std::ptrdiff_t((p + 1) * b.count * 3),
                   a.mutable_data());
+        check_finite_result("reference_radiance", a.data(), std::size_t(a.size()),
+                            "the cube's, the material's or the model's finite values are too large (the sums overflow)");
         result[names[p]] = a;
     }
     return result;

@@ -108,6 +108,7 @@ py::list read_ktx2(const std::string& path) {
 
 py::array_t<float> cube_from_latlong(py::object image, int size, int supersample, unsigned threads) {
     using img_array = py::array_t<float, py::array::c_style | py::array::forcecast>;
+    refuse_complex("cube_from_latlong", "img", image);
     img_array a = img_array::ensure(image);
     if (!a) throw py::type_error("ibl.cube_from_latlong: img must be a real array of shape (h, 2h, 3)");
     if (a.ndim() != 3 || a.shape(2) != 3 || a.shape(0) < 1 || a.shape(1) != 2 * a.shape(0))
@@ -150,6 +151,8 @@ py::array_t<float> cube_from_latlong(py::object image, int size, int supersample
                 q[1] = t.y;
                 q[2] = t.z;
             }
+    check_finite_result("cube_from_latlong", out.data(), std::size_t(out.size()),
+                        "the image's finite values are too large for float (the sums overflow); scale it down");
     return out;
 }
 

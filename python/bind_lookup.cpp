@@ -29,6 +29,7 @@ ibl::cubemap<float> chain_from_list(const char* fn, py::sequence levels) {
     std::vector<f32_array> arrays;
     py::ssize_t n = 0;
     for (std::size_t l = 0; l < count; ++l) {
+        refuse_complex(fn, "chain_levels", levels[l]);
         f32_array a = f32_array::ensure(levels[l]);
         if (!a) throw py::type_error(std::string("ibl.") + fn + ": chain level " + std::to_string(l) + " is not a real array");
         const py::ssize_t want = l == 0 ? (a.ndim() == 4 ? a.shape(1) : 0) : std::max<py::ssize_t>(1, n >> l);
@@ -104,6 +105,7 @@ py::object specular_lookup(py::sequence chain_levels, py::object dirs, py::objec
 }
 
 py::object dfg_lookup(py::object lut_obj, py::object n_dot_v, py::object roughness, const std::string& layout) {
+    refuse_complex("dfg_lookup", "lut", lut_obj);
     f32_array a = f32_array::ensure(lut_obj);
     if (!a) throw py::type_error("ibl.dfg_lookup: lut must be a real array (size, size, 2 or 3)");
     if (a.ndim() != 3 || a.shape(0) < 1 || a.shape(0) != a.shape(1) || (a.shape(2) != 2 && a.shape(2) != 3))

@@ -28,6 +28,29 @@ struct arg {
 
 inline bool is_f32(const py::dtype& d) { return d.kind() == 'f' && d.itemsize() == 4; }
 
+/// TypeError for a complex array or NumPy scalar: NumPy's forced cast to a real dtype would
+/// drop the imaginary part silently (with a ComplexWarning at most).
+inline void refuse_complex(const char* fn, const char* name, py::handle obj) {
+    bool complex = false;
+    if (py::isinstance<py::array>(obj)) complex = py::reinterpret_borrow<py::array>(obj).dtype().kind() == 'c';
+    else if (PyComplex_Check(obj.ptr())) complex = true;
+    else if (py::hasattr(obj, "dtype") && py::hasattr(obj, "shape")) {
+        py::object dt = obj.attr("dtype");
+        complex = py::isinstance<py::dtype>(dt) && py::reinterpret_borrow<py::dtype>(dt).kind() == 'c';
+    }
+    if (complex)
+        throw py::type_error(std::string("ibl.") + fn + ": argument '" + name + "' is complex; a real array is expected");
+}
+
+/// ValueError when a result holds a non-finite value: the inputs were finite, but too large (a
+/// cube near float's range, a model returning huge values) for the computation not to overflow.
+template <class T> void check_finite_result(const char* fn, const T* p, std::size_t n, const char* cause) {
+    for (std::size_t i = 0; i < n; ++i)
+        if (!std::isfinite(p[i]))
+            throw py::value_error(std::string("ibl.") + fn + ": the result is not finite (" + std::to_string(double(p[i])) +
+                                  " at flat index " + std::to_string(i) + "): " + cause);
+}
+
 /// True when every NumPy argument is float32 (and at least one is): the computation then runs in
 /// float, otherwise in double. Python numbers do not vote (as NumPy 2's promotion rules).
 inline bool all_float32(const std::vector<arg>& args) {
@@ -60,6 +83,9 @@ template <class T> broadcast_args<T> broadcast(const char* fn, const std::vector
     std::vector<py::array> conv;
     py::list leads;
     for (const arg& a : args) {
+        if (a.obj.is_none()) // NumPy would make it NaN
+            throw py::type_error(std::string("ibl.") + fn + ": argument '" + a.name + "' is None; a real number or array is expected");
+        refuse_complex(fn, a.name, a.obj);
         py::array x = py::array_t<T, py::array::c_style | py::array::forcecast>::ensure(a.obj);
         if (!x) throw py::type_error(std::string("ibl.") + fn + ": argument '" + a.name + "' is not a real number array");
         if (a.core > 1) {

@@ -2,7 +2,9 @@
 # real array. Element-wise functions broadcast their arguments (a trailing axis of 2 or 3 where a
 # vector is expected), compute in float32 when every NumPy input is float32 and in float64
 # otherwise, and return a new array (a Python float when every input is a scalar). Roughness and
-# alpha arguments must lie in [0, 1] (ValueError otherwise, also for NaN).
+# alpha arguments must lie in [0, 1] (ValueError otherwise, also for NaN). Complex input: TypeError.
+# A non-finite result of finite input that overflows (a cube near float's range, a Python model
+# returning huge values): ValueError (docs/python.md, "Bad input and fuzzing").
 from typing import Any, Optional, Protocol, Sequence, Union
 
 import numpy as np
