@@ -490,22 +490,21 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 });
             }
         }
-        out.update_borders();
-        return specular_chain(std::move(out), opt.weight, opt.policy.mapping);
-    }
-    for (int k = 0; k < int(plan.size()); ++k) {
-        const prefilter_level& lp = plan[std::size_t(k)];
-        const int n = out.size(k);
-        std::vector<vec3<float>> texels;
-        if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
-            texels = detail::prefilter_base(env, n, lp.trilinear, ex);
-        } else {
-            sphere_sample_table<float> table =
-                make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt.method, opt.lod_bias, opt.weight);
-            table.trilinear = lp.trilinear;
-            texels = convolve_faces(env, table, n, ex);
+    } else {
+        for (int k = 0; k < int(plan.size()); ++k) {
+            const prefilter_level& lp = plan[std::size_t(k)];
+            const int n = out.size(k);
+            std::vector<vec3<float>> texels;
+            if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
+                texels = detail::prefilter_base(env, n, lp.trilinear, ex);
+            } else {
+                sphere_sample_table<float> table =
+                    make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt.method, opt.lod_bias, opt.weight);
+                table.trilinear = lp.trilinear;
+                texels = convolve_faces(env, table, n, ex);
+            }
+            out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
         }
-        out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
     }
     out.update_borders();
     return specular_chain(std::move(out), opt.weight, opt.policy.mapping);
