@@ -9,8 +9,8 @@
 // sun 10^4 times the sky, a studio's lamps) is then smeared over the footprints or missed between
 // samples, and the filtered level shows it as blotches. The error grows with the light's contrast,
 // not with the smoothness of the rest: without its sun the built-in sky filters to 1-4 % relative
-// RMSE with 16 samples, with it to 40-300 % (docs/ibl-bake.md, "Fast filter"). The split removes
-// that dependence:
+// RMSE with 16 samples, with it to 13-190 % at 4-64 samples (docs/ibl-bake.md, "Fast filter").
+// The split removes that dependence:
 //
 //     S = B + P,   LD[S] = LD[B] + LD[P],
 //
