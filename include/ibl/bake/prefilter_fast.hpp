@@ -47,7 +47,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <span>
+#include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "../brdf/ggx.hpp"
@@ -133,6 +138,27 @@ template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_
     for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
     return c;
 }
+/// The GGX lobe's radial CDF, memoised per (roughness, weight): a process-wide cache of at most 64
+/// entries (cleared when full) behind a mutex, so that a real-time caller who filters the same
+/// levels every frame does not rebuild the 4097-node quadrature per level and per call. Only the
+/// built-in GGX lobe is cached (its kernel depends on nothing else); the values are those of
+/// make_fast_radial_cdf.
+inline std::shared_ptr<const fast_radial_cdf> ggx_fast_radial_cdf(double roughness, ld_weight weight) {
+    static std::mutex mutex;
+    static std::map<std::pair<double, int>, std::shared_ptr<const fast_radial_cdf>> cache;
+    const std::pair<double, int> key(roughness, int(weight));
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        const auto it = cache.find(key);
+        if (it != cache.end()) return it->second;
+    }
+    auto c = std::make_shared<const fast_radial_cdf>(make_fast_radial_cdf<ggx_lobe>(roughness, weight));
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (cache.size() >= 64) cache.clear();
+    cache.emplace(key, c);
+    return c;
+}
+
 /// The radius where the CDF reaches u (linear between grid points).
 inline double fast_cdf_at(const fast_radial_cdf& c, double u) noexcept {
     const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
@@ -158,7 +184,10 @@ sphere_sample_table<S> make_fast_ld_table(double roughness, std::uint32_t sample
     const std::uint32_t n = std::max<std::uint32_t>(1, samples);
     const double tail = std::isfinite(shape.tail) && shape.tail > 0.0 ? shape.tail : 1.0;
     const double bias4 = std::exp2(2.0 * (std::isfinite(shape.lod_bias) ? shape.lod_bias : 0.0));
-    const detail::fast_radial_cdf cdf = detail::make_fast_radial_cdf<Lobe>(r, weight);
+    std::shared_ptr<const detail::fast_radial_cdf> cdf_ptr;
+    if constexpr (std::is_same_v<Lobe, ggx_lobe>) cdf_ptr = detail::ggx_fast_radial_cdf(r, weight);
+    else cdf_ptr = std::make_shared<const detail::fast_radial_cdf>(detail::make_fast_radial_cdf<Lobe>(r, weight));
+    const detail::fast_radial_cdf& cdf = *cdf_ptr;
     const double norm = 2.0 * pi_v<double> * cdf.total; // integral of K over the sphere
     constexpr double golden = 2.399963229728653;         // pi (3 - sqrt 5)
     auto warp = [&](double x) { return 1.0 - std::pow(1.0 - x, tail); };

@@ -349,7 +349,7 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
     const double a = std::max(alpha_from_roughness(r), 1e-4), a2 = a * a;
-    const double norm = 2.0 * pi_v<double> * detail::make_fast_radial_cdf<ggx_lobe>(r, weight).total;
+    const double norm = 2.0 * pi_v<double> * detail::ggx_fast_radial_cdf(r, weight)->total;
     if (!(norm > 0.0)) return pl;
     const double scale = a2 / (4.0 * pi_v<double> * norm);
     const int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
