@@ -67,7 +67,6 @@ struct baked_probe {
     std::vector<ktx2_quantisation_level> quantisation;
 };
 
-constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 reference texel mean (as stage_specular.cpp)
 
 /// Solid-angle-weighted mean luminance of level 0.
 double mean_luminance(const ibl::cubemap<float>& cube) {
@@ -99,20 +98,7 @@ std::vector<probe_level_check> check_chain(const source_env& src, const ibl::cub
         lc.roughness = lp.roughness;
         lc.samples = lp.samples;
         const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qc.ref_grid, light);
-        std::vector<dvec3> ref(texels.size());
-        src.visit([&](const auto& env) {
-            ex(texels.size(), [&](std::size_t b, std::size_t e) {
-                for (std::size_t i = b; i < e; ++i) {
-                    const auto& t = texels[i];
-                    const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size);
-                    if (lp.level == 0) ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
-                    else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
-                        ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qc.sky_ref_samples, qc.sun_cap_nodes, weight);
-                    else ref[i] = ibl::reference_ld(env, d, lc.roughness, qc.ld_ref_samples, weight);
-                }
-            });
-            return 0;
-        });
+        const std::vector<dvec3> ref = chain_check_references(src, texels, lc.size, lp.level == 0, lc.roughness, qc, weight, ex);
         ibl::error_accumulator acc(floor);
         for (std::size_t i = 0; i < texels.size(); ++i)
             acc.add(dvec3(chain.texel(texels[i][0], texels[i][1], texels[i][2], k)), ref[i]);

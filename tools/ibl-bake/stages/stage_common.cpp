@@ -7,6 +7,7 @@
 #include <locale>
 #include <span>
 #include <sstream>
+#include <type_traits>
 
 #include <ibl/core/color.hpp>
 #include <ibl/env/convert.hpp>
@@ -412,6 +413,26 @@ void json_triples(json_writer& j, const sh5& c, int count) {
         j.end_array();
     }
     j.end_array();
+}
+
+std::vector<dvec3> chain_check_references(const source_env& src, const std::vector<std::array<int, 3>>& texels, int n,
+                                          bool mirror, double roughness, const quality_settings& qs, ibl::ld_weight w,
+                                          pool_executor& ex) {
+    std::vector<dvec3> ref(texels.size());
+    src.visit([&](const auto& env) {
+        ex(texels.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+                const auto& t = texels[i];
+                const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], n);
+                if (mirror) ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], n, level0_ref_k);
+                else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
+                    ref[i] = ibl::reference_ld_sky(env, d, roughness, qs.sky_ref_samples, qs.sun_cap_nodes, w);
+                else ref[i] = ibl::reference_ld(env, d, roughness, qs.ld_ref_samples, w);
+            }
+        });
+        return 0;
+    });
+    return ref;
 }
 
 std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method) {

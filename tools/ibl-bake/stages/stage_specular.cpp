@@ -25,8 +25,6 @@ namespace ibl_bake {
 
 namespace {
 
-constexpr int level0_ref_k = 16; ///< sub-samples per axis of the level-0 reference texel mean
-
 /// The roughness <-> lod rule of a policy, as the files and report.json state it.
 const char* policy_rule(ibl::roughness_mip_policy p) {
     return p.mapping == ibl::roughness_mapping::filament ? "filament: lod = (V - 1) r (2 - r)" : "linear: lod = (V - 1) r";
@@ -176,20 +174,8 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
     lc.samples = lp.samples;
     lc.trilinear = lp.trilinear && method_ != prefilter_choice::fast; // the fast filter reads the nearest level
     const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qs_.ref_grid, ctx.light);
-    std::vector<dvec3> ref(texels.size());
-    ctx.src.visit([&](const auto& env) {
-        ctx.ex(texels.size(), [&](std::size_t b, std::size_t e) {
-            for (std::size_t i = b; i < e; ++i) {
-                const auto& t = texels[i];
-                const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], lc.size);
-                if (lp.level == 0) ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], lc.size, level0_ref_k);
-                else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
-                    ref[i] = ibl::reference_ld_sky(env, d, lc.roughness, qs_.sky_ref_samples, qs_.sun_cap_nodes, weight_);
-                else ref[i] = ibl::reference_ld(env, d, lc.roughness, qs_.ld_ref_samples, weight_);
-            }
-        });
-        return 0;
-    });
+    const std::vector<dvec3> ref =
+        chain_check_references(ctx.src, texels, lc.size, lp.level == 0, lc.roughness, qs_, weight_, ctx.ex);
     // Relative errors use a floor of 1e-3 x the mean radiance (dark texels do not dominate). With an
     // extracted sun the product is what the runtime gets: the level plus the sun's LD term (level 0:
     // the texel with the removed excess added back, i.e. the source before extraction).

@@ -181,6 +181,17 @@ std::vector<std::pair<std::string, std::string>> table_conventions(const bake_co
 /// Direction of the brightest texel of a cube level (luminance; first one on ties).
 dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
 
+/// Sub-samples per axis of the level-0 reference texel mean of the chain checks.
+inline constexpr int level0_ref_k = 16;
+/// The references a chain level is checked against at `texels` (face, x, y) of its n x n faces:
+/// level 0 (mirror = true) the level0_ref_k^2 sub-sampled texel mean of the source; rougher
+/// levels ibl::reference_ld_sky (analytic sky) or ibl::reference_ld (maps) at `roughness` with
+/// the quality settings' samples and the chain's LD weight. One definition for the bake's check
+/// and the probe set's.
+std::vector<dvec3> chain_check_references(const source_env& src, const std::vector<std::array<int, 3>>& texels, int n,
+                                          bool mirror, double roughness, const quality_settings& qs, ibl::ld_weight w,
+                                          pool_executor& ex);
+
 /// The sun's LD at direction d and roughness r for a chain of weight w (its exact term, host
 /// quadrature); 0 without one.
 dvec3 sun_ld(const ibl::disk_light<double>* sun, const dvec3& d, double roughness, ibl::ld_weight w);
