@@ -122,6 +122,12 @@ struct fit_case {
     std::uint32_t budget;
 };
 
+/// The fast table's reads in the objective: false = trilinear at each tap's lod, true = the
+/// nearest level round(lod) (what the fast filter's default plan reads).
+bool g_nearest = false;
+/// The contrasts of the objective (the bright texel's filtered peak over the background).
+std::vector<double> g_contrasts{10.0, 100.0, 1000.0};
+
 struct evaluator {
     const std::vector<probe>* probes;
     fit_case c;
@@ -149,8 +155,16 @@ struct evaluator {
 
     double error(const ibl::fast_tap_shape& shape) const {
         return error_of([&](const probe& p) {
-            return ibl::make_fast_ld_table<double>(
+            ibl::sphere_sample_table<double> t = ibl::make_fast_ld_table<double>(
                 c.roughness, c.budget, shape, [&](double omega) { return double(p.cube.lod_for_solid_angle(float(omega))); }, c.weight);
+            if (g_nearest) { // make_taps' rule: the level of floor(lod) + 1 from a fraction of 0.5 up
+                const double max_lod = double(p.cube.levels() - 1);
+                for (double& l : t.lod) {
+                    const double c = std::clamp(l, 0.0, max_lod);
+                    l = c - std::floor(c) < 0.5 ? std::floor(c) : std::floor(c) + 1.0;
+                }
+            }
+            return t;
         });
     }
     /// The same error for filtered importance sampling with N samples (bias 0.5, trilinear).
@@ -178,7 +192,7 @@ struct evaluator {
                 got[k] = acc / wsum;
             }
             const double peak = *std::max_element(exact[pi].begin(), exact[pi].end());
-            for (double c : {10.0, 100.0, 1000.0}) {
+            for (double c : g_contrasts) {
                 const double bg = peak / c;
                 double se = 0.0, area = 0.0;
                 for (std::size_t k = 0; k < dirs[pi].size(); ++k) {
@@ -241,6 +255,8 @@ int main(int argc, char** argv) {
         if (!std::strcmp(argv[i], "--write-header") && i + 1 < argc) header = argv[++i];
         else if (!std::strcmp(argv[i], "--fis")) fis = true;
         else if (!std::strcmp(argv[i], "--check")) check = true;
+        else if (!std::strcmp(argv[i], "--nearest")) g_nearest = true;
+        else if (!std::strcmp(argv[i], "--contrast") && i + 1 < argc) g_contrasts = {std::atof(argv[++i])};
         else if (!std::strcmp(argv[i], "--show") && i + 2 < argc) show_r = std::atof(argv[i + 1]), show_budget = std::uint32_t(std::atoi(argv[i + 2])), i += 2;
         else {
             std::fprintf(stderr, "usage: fast_filter_fit [--write-header PATH] [--fis] [--show R N] [--check]\n");

@@ -1,0 +1,360 @@
+// research/fast_tap_study.cpp — the fast filter's tap sets against exact references on real
+// HDRIs: the table "Against exact references" of docs/ibl-bake.md ("Fast filter").
+//
+//   build/release/research/fast_tap_study [--texels N] [FILE.exr ...]   (default: the courtyard and
+//                                                                         studio of tests/data, 400)
+//   build/release/research/fast_tap_study --quick                        (ctest: one file, 32 texels)
+//
+// What it measures. ibl-bake's check compares a chain with reference_ld at 1024 (--checks fast,
+// the default) or 4096 (--checks full) GGX samples per texel; on a real HDRI that reference is
+// itself noisy, and at the default filter's accuracy the noise dominates the figure. Here the
+// reference is reference_ld with 2^15 samples (lat-long source, as the tool) at N random texels
+// per level of a 256^2, 6-level chain (r = l / 5, n.l weight), and the table lists:
+//   * the check's own references (1024 and 4096 samples) against it: the floor of the tool's figures;
+//   * filtered importance sampling with the default schedule (512 x 2^(l-1), trilinear, bias 0.5);
+//   * the fast filter's tap set (bake/prefilter_fast.hpp, the fitted shapes, nearest reads), no peak split;
+//   * candidates for its successor:
+//     - the spiral with a fixed shape (tail 2.5, lod bias -0.5: finer reads);
+//     - the coarse tail: level l is filtered coarse to fine as
+//         LD_l(R) = (Z_rest / Z_l) [spiral of K_l - c K_(l+1)](R) + (c Z_(l+1) / Z_l) LD_(l+1)(R),
+//       c the largest multiple of the next level's kernel under this one's on the hemisphere (GGX
+//       tails fall as alpha^2 / theta^4, so K_l - c K_(l+1) falls as theta^-6: the heavy tail is
+//       read from the finished coarser level, one bilinear tap, and the spiral's samples go to the
+//       core); Z = the kernels' integrals;
+//     - a polar grid: a centre disk of radius alpha / 2, then bands growing by rho, square cells,
+//       each read at the lod of its solid angle (bias -0.5), weighted by its exact kernel mass.
+// Taps per chain: sum over levels 1-5 of 6 n_l^2 taps_l (two per trilinear sample). The sun of an
+// analytic sky is left out: the peak split (bake/prefilter_peaks.hpp) takes such lights out of
+// every tap set.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <array>
+#include <cstdlib>
+#include <functional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/core/executor.hpp>
+#include <ibl/env/convert.hpp>
+#include <ibl/env/latlong.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/reference/radiance.hpp>
+
+#include "io/image_io.hpp"
+
+using ibl::vec3;
+using dvec3 = ibl::vec3<double>;
+
+namespace {
+double unit(std::uint32_t a, std::uint32_t b) {
+    return double(ibl::detail::rr_hash(ibl::detail::rr_hash(a * 0x9e3779b9u + 17u) ^ b) >> 8) * 0x1p-24;
+}
+double lum(const dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+double cdf_at_theta(const ibl::detail::fast_radial_cdf& c, double t) {
+    auto it = std::lower_bound(c.theta.begin(), c.theta.end(), t);
+    if (it == c.theta.begin()) return 0.0;
+    if (it == c.theta.end()) return 1.0;
+    const std::size_t i = std::size_t(it - c.theta.begin());
+    const double f = (t - c.theta[i - 1]) / (c.theta[i] - c.theta[i - 1]);
+    return c.cdf[i - 1] + f * (c.cdf[i] - c.cdf[i - 1]);
+}
+
+struct texel_ref {
+    int f, x, y;
+    dvec3 ref;
+};
+
+// Polar grid: a centre disk of radius theta0, then bands growing by rho up to pi/2, each of
+// m = round(2 pi theta_mid / width x aspect) cells with its tap at the band's mass-median radius.
+ibl::sphere_sample_table<float> polar_table(const ibl::cubemap<float>& cube, double r, double theta0, double rho,
+                                            double aspect, double bias, bool tri, ibl::ld_weight w, double tmax = 0.5 * M_PI) {
+    const ibl::detail::fast_radial_cdf c = ibl::detail::make_fast_radial_cdf<ibl::ggx_lobe>(r, w);
+    ibl::sphere_sample_table<float> t;
+    t.trilinear = tri;
+    auto lod = [&](double omega) { return double(cube.lod_for_solid_angle(float(omega * std::exp2(2.0 * bias)))); };
+    // centre tap
+    {
+        const double m = cdf_at_theta(c, theta0);
+        const double om = 2.0 * M_PI * (1.0 - std::cos(theta0));
+        t.push(vec3<float>(0, 0, 1), float(m), float(lod(om)));
+    }
+    double lo = theta0;
+    int band = 0;
+    while (lo < tmax - 1e-9) {
+        double hi = std::min(tmax, lo * rho);
+        if (tmax - hi < 0.3 * (hi - lo)) hi = tmax;
+        const double c0 = cdf_at_theta(c, lo), c1 = cdf_at_theta(c, hi);
+        const double mid = ibl::detail::fast_cdf_at(c, 0.5 * (c0 + c1));
+        const int m = std::max(3, int(std::lround(2.0 * M_PI * 0.5 * (lo + hi) / (hi - lo) * aspect)));
+        const double om = 2.0 * M_PI * (std::cos(lo) - std::cos(hi)) / m;
+        const double off = (band % 2) * 0.5;
+        for (int j = 0; j < m; ++j) {
+            const double ph = 2.0 * M_PI * (j + off) / m;
+            t.push(vec3<float>(float(std::sin(mid) * std::cos(ph)), float(std::sin(mid) * std::sin(ph)), float(std::cos(mid))),
+                   float((c1 - c0) / m), float(lod(om)));
+        }
+        lo = hi;
+        ++band;
+    }
+    t.drawn = std::uint32_t(t.size());
+    return t;
+}
+
+
+struct kernel_tab {
+    std::vector<double> theta, cdf, k;
+    double total = 0;
+};
+// Tabulates K (any function of theta) on the grid of make_fast_radial_cdf, with its radial CDF.
+template <class K> kernel_tab tabulate(K&& kf, double r) {
+    constexpr int m = 4096;
+    kernel_tab c;
+    const double lo = 1e-6 * ibl::fast_lobe_scale(r), hi = 0.5 * M_PI;
+    c.theta.push_back(0.0);
+    c.cdf.push_back(0.0);
+    c.k.push_back(kf(0.0));
+    double prev_t = 0.0, prev_f = 0.0, acc = 0.0;
+    for (int i = 0; i <= m; ++i) {
+        const double t = lo * std::pow(hi / lo, double(i) / m);
+        const double kv = std::max(0.0, kf(t));
+        const double f = kv * std::sin(t);
+        acc += 0.5 * (f + prev_f) * (t - prev_t);
+        c.theta.push_back(t);
+        c.cdf.push_back(acc);
+        c.k.push_back(kv);
+        prev_t = t, prev_f = f;
+    }
+    c.total = acc;
+    for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
+    return c;
+}
+double tab_inv(const kernel_tab& c, double u) {
+    const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
+    if (it == c.cdf.begin()) return 0.0;
+    if (it == c.cdf.end()) return c.theta.back();
+    const std::size_t k = std::size_t(it - c.cdf.begin());
+    const double d = c.cdf[k] - c.cdf[k - 1];
+    const double f = d > 0.0 ? (u - c.cdf[k - 1]) / d : 0.0;
+    return c.theta[k - 1] + f * (c.theta[k] - c.theta[k - 1]);
+}
+double tab_k(const kernel_tab& c, double t) {
+    auto it = std::lower_bound(c.theta.begin(), c.theta.end(), t);
+    if (it == c.theta.begin()) return c.k.front();
+    if (it == c.theta.end()) return c.k.back();
+    const std::size_t i = std::size_t(it - c.theta.begin());
+    const double f = (t - c.theta[i - 1]) / (c.theta[i] - c.theta[i - 1]);
+    return c.k[i - 1] + f * (c.k[i] - c.k[i - 1]);
+}
+ibl::sphere_sample_table<float> spiral_table(const ibl::cubemap<float>& cube, const kernel_tab& c, std::uint32_t n,
+                                             double tail, double bias, bool tri) {
+    const double norm = 2.0 * M_PI * c.total;
+    auto warp = [&](double x) { return 1.0 - std::pow(1.0 - x, tail); };
+    ibl::sphere_sample_table<float> t;
+    t.trilinear = tri;
+    for (std::uint32_t i = 0; i < n; ++i) {
+        const double u0 = warp(double(i) / n), u1 = i + 1 == n ? 1.0 : warp(double(i + 1) / n);
+        const double mass = u1 - u0;
+        const double theta = tab_inv(c, warp((i + 0.5) / n));
+        const double k = tab_k(c, theta);
+        if (!(mass > 0) || !(k > 0)) continue;
+        const double omega = mass / (k / norm);
+        const double phi = 2.399963229728653 * i;
+        t.push(vec3<float>(float(std::sin(theta) * std::cos(phi)), float(std::sin(theta) * std::sin(phi)), float(std::cos(theta))),
+               float(mass), float(cube.lod_for_solid_angle(float(omega * std::exp2(2.0 * bias)))));
+    }
+    t.drawn = n;
+    return t;
+}
+
+double rel_rmse(const std::vector<vec3<float>>& tex, int n, const std::vector<texel_ref>& refs) {
+    double s = 0;
+    for (const texel_ref& r : refs) {
+        const dvec3 v(tex[ibl::cube_texel_index(r.f, r.x, r.y, n)]);
+        const double a = lum(v), b = lum(r.ref);
+        s += (a - b) * (a - b) / (b * b);
+    }
+    return std::sqrt(s / double(refs.size()));
+}
+struct design {
+    std::string name;
+    // The table of level l (roughness r) for a source; reuse > 0 marks the coarse-tail designs.
+    std::function<ibl::sphere_sample_table<float>(const ibl::cubemap<float>&, int, double)> table;
+    bool reuse = false;
+    double tail = 1.0, bias = 0.0;
+    std::uint32_t n0 = 0;
+};
+
+/// Per level of the chain, the rel RMSE of luminance at the reference texels and the taps.
+struct chain_result {
+    std::vector<double> err;
+    double taps = 0;
+};
+
+constexpr int chain_levels = 6;
+constexpr int base_size = 256;
+double level_r(int l) { return double(l) / double(chain_levels - 1); }
+std::uint32_t doubling(std::uint32_t n0, int l) { return ibl::doubling_prefilter_samples(n0, l); }
+
+chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const std::vector<std::vector<texel_ref>>& refs,
+                        ibl::ld_weight w, ibl::thread_executor& ex) {
+    chain_result res;
+    res.err.assign(chain_levels, 0.0);
+    ibl::cubemap<float> next(1, 1); // the coarser level just computed (coarse-tail designs)
+    for (int l = chain_levels - 1; l >= 1; --l) {
+        const int n = base_size >> l;
+        const double r = level_r(l);
+        std::vector<vec3<float>> out;
+        if (d.reuse && l + 1 < chain_levels) {
+            const double r1 = level_r(l + 1);
+            auto K0 = [&](double t) { return ibl::detail::fast_kernel<ibl::ggx_lobe>(t, r, w); };
+            auto K1 = [&](double t) { return ibl::detail::fast_kernel<ibl::ggx_lobe>(t, r1, w); };
+            double c = 1e300; // the largest multiple of K1 under K0 on the hemisphere
+            for (int i = 1; i < 4000; ++i) {
+                const double t = 0.5 * M_PI * i / 4000.0;
+                if (K1(t) > 0 && K0(t) > 0) c = std::min(c, K0(t) / K1(t));
+            }
+            const kernel_tab k0 = tabulate(K0, r), k1 = tabulate(K1, r1);
+            const kernel_tab rest = tabulate([&](double t) { return K0(t) - c * K1(t); }, r);
+            const double a_rest = rest.total / k0.total, a_next = c * k1.total / k0.total;
+            const auto t = spiral_table(cube, rest, doubling(d.n0, l), d.tail, d.bias, false);
+            res.taps += 6.0 * n * n * double(t.size() + 1);
+            const auto tex = ibl::convolve_faces(cube, t, n, ex);
+            out.resize(tex.size());
+            for (int f = 0; f < 6; ++f)
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x) {
+                        const std::size_t i = ibl::cube_texel_index(f, x, y, n);
+                        const vec3<float> dir = ibl::cube_texel_direction<float>(f, x, y, n);
+                        out[i] = tex[i] * float(a_rest) + float(a_next) * vec3<float>(next.radiance(dir, 0.f));
+                    }
+        } else {
+            const auto t = d.table(cube, l, r);
+            res.taps += 6.0 * n * n * double(t.size()) * (t.trilinear ? 2.0 : 1.0);
+            out = ibl::convolve_faces(cube, t, n, ex);
+        }
+        res.err[std::size_t(l)] = rel_rmse(out, n, refs[std::size_t(l)]);
+        next = ibl::cubemap<float>(n, 1);
+        next.fill(0, [&](int f, int x, int y) { return out[ibl::cube_texel_index(f, x, y, n)]; });
+        next.update_borders();
+    }
+    return res;
+}
+} // namespace
+
+int main(int argc, char** argv) {
+    int texels = 400;
+    std::vector<std::string> files;
+    bool quick = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--texels" && i + 1 < argc) texels = std::max(16, std::atoi(argv[++i]));
+        else if (a == "--quick") quick = true;
+        else files.push_back(a);
+    }
+    if (files.empty()) files = {std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr", std::string(IBL_RESEARCH_DATA_DIR) + "/studio.exr"};
+    if (quick) files.resize(1), texels = 32;
+    const ibl::ld_weight w = ibl::ld_weight::n_dot_l;
+    std::vector<design> designs;
+    if (!quick) designs.push_back({"fis default (512, trilinear)", [&](const ibl::cubemap<float>& c, int l, double r) {
+                           auto t = ibl::make_ld_table_for<float>(c, r, doubling(512, l), ibl::prefilter_method::filtered_importance, 0.5, w);
+                           t.trilinear = true;
+                           return t;
+                       }});
+    for (std::uint32_t n0 : {8u, 16u, 32u, 64u, 128u, 256u}) {
+        if (quick && n0 > 16) break;
+        designs.push_back({"fast, fitted shapes, " + std::to_string(n0), [=](const ibl::cubemap<float>& c, int l, double r) {
+                               auto t = ibl::make_ld_table_for<float>(c, r, doubling(n0, l), ibl::prefilter_method::fast, 0.0, w);
+                               t.trilinear = false;
+                               return t;
+                           }});
+    }
+    for (std::uint32_t n0 : {16u, 32u, 64u, 128u}) {
+        if (quick && n0 > 16) break;
+        designs.push_back({"spiral tail 2.5 bias -0.5, " + std::to_string(n0), [=](const ibl::cubemap<float>& c, int l, double r) {
+                               return spiral_table(c, tabulate([&](double t) { return ibl::detail::fast_kernel<ibl::ggx_lobe>(t, r, w); }, r),
+                                                   doubling(n0, l), 2.5, -0.5, false);
+                           }});
+        design d{"coarse tail + spiral 2.5 / -0.5, " + std::to_string(n0), designs.back().table, true, 2.5, -0.5, n0};
+        designs.push_back(d);
+    }
+    for (double rho : {1.5, 2.0}) {
+        if (quick) break;
+        designs.push_back({"polar grid rho " + std::to_string(rho).substr(0, 3) + " bias -0.5", [=](const ibl::cubemap<float>& c, int, double r) {
+                               const double a = std::max(r * r, 1e-3);
+                               return polar_table(c, r, 0.5 * a, rho, 1.0, -0.5, false, w);
+                           }});
+    }
+    ibl::thread_executor ex{2};
+    for (const std::string& file : files) {
+        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file, {});
+        ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);
+        map.update_borders();
+        const int k = std::max(2, int(std::ceil(double(img.width) / (4.0 * base_size))));
+        const ibl::cubemap<float> cube = ibl::bake_cubemap<float>(map, base_size, k, ex, 0);
+        std::vector<std::vector<texel_ref>> refs(chain_levels);
+        std::vector<std::array<double, 2>> floor(chain_levels);
+        for (int l = 1; l < chain_levels; ++l) {
+            const int n = base_size >> l;
+            const double r = level_r(l);
+            auto& rl = refs[std::size_t(l)];
+            rl.resize(std::size_t(texels));
+            std::vector<std::array<dvec3, 2>> check(rl.size());
+            ex(rl.size(), [&](std::size_t b, std::size_t e) {
+                for (std::size_t i = b; i < e; ++i) {
+                    texel_ref& t = rl[i];
+                    t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
+                    t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
+                    t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
+                    const dvec3 dir = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
+                    t.ref = ibl::reference_ld(map, dir, r, quick ? 1u << 12 : 1u << 15, w);
+                    check[i] = {ibl::reference_ld(map, dir, r, 1024, w), ibl::reference_ld(map, dir, r, 4096, w)};
+                }
+            });
+            for (int q = 0; q < 2; ++q) {
+                double s = 0;
+                for (std::size_t i = 0; i < rl.size(); ++i) {
+                    const double a = lum(check[i][std::size_t(q)]), b = lum(rl[i].ref);
+                    s += (a - b) * (a - b) / (b * b);
+                }
+                floor[std::size_t(l)][std::size_t(q)] = std::sqrt(s / double(rl.size()));
+            }
+        }
+        std::printf("\n%s: 256^2, 6 levels (r = l/5), n.l weight, %d texels per level, reference %s GGX samples on the lat-long map\n\n",
+                    file.substr(file.find_last_of('/') + 1).c_str(), texels, quick ? "2^12" : "2^15");
+        std::printf("| tap set (samples at level 1, doubling) | taps per chain | levels 1-5 rel RMSE |\n|---|---|---|\n");
+        std::printf("| the check's own reference, 1024 samples (--checks fast) | - |");
+        for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", floor[std::size_t(l)][0]);
+        std::printf(" |\n| the check's own reference, 4096 samples (default checks) | - |");
+        for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", floor[std::size_t(l)][1]);
+        std::printf(" |\n");
+        std::vector<chain_result> results;
+        for (const design& d : designs) {
+            const chain_result cr = run_design(d, cube, refs, w, ex);
+            results.push_back(cr);
+            std::printf("| %s | %.2f M |", d.name.c_str(), cr.taps * 1e-6);
+            for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", cr.err[std::size_t(l)]);
+            std::printf(" |\n");
+            std::fflush(stdout);
+        }
+        // --quick (ctest): every figure finite, and the coarse tail below the same spiral without
+        // it on levels 1 and 2 (the designs are pushed as pairs: spiral, then coarse tail).
+        int bad = 0;
+        for (std::size_t i = 0; i < designs.size(); ++i)
+            for (int l = 1; l < chain_levels; ++l) bad += std::isfinite(results[i].err[std::size_t(l)]) ? 0 : 1;
+        for (std::size_t i = 1; i < designs.size(); ++i)
+            if (designs[i].reuse)
+                for (int l = 1; l <= 2; ++l)
+                    if (!(results[i].err[std::size_t(l)] < results[i - 1].err[std::size_t(l)])) {
+                        std::printf("coarse tail not below the spiral at level %d: %g >= %g\n", l, results[i].err[std::size_t(l)],
+                                    results[i - 1].err[std::size_t(l)]);
+                        ++bad;
+                    }
+        if (quick && bad) return 1;
+    }
+    return 0;
+}
