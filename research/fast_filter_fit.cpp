@@ -6,6 +6,11 @@
 //   build/dev/research/fast_filter_fit --fis --show R N     filtered importance sampling's error
 //   build/dev/research/fast_filter_fit --check              re-fits two rows of the compiled-in
 //                                                           table; fails when they differ (ctest)
+//   --nearest      the objective reads the nearest level (the default plan's reads), not trilinear
+//   --contrast C   one contrast C instead of 10, 100 and 1000 (below the peak split's threshold)
+// With --nearest, or with contrasts of 2-10 (what is left to the tap set after the peak split),
+// the fitted biases move to +0 .. +0.5, while on the HDRIs finer reads (-0.5) do better
+// (research/fast_tap_study.cpp): the point light is not the content that decides the error there.
 //
 // Objective (the header's derivation): a 256^2 source that is one bright texel, at a face
 // centre, on an edge and at a corner; its exact LD response E at direction R is the kernel about
@@ -259,7 +264,7 @@ int main(int argc, char** argv) {
         else if (!std::strcmp(argv[i], "--contrast") && i + 1 < argc) g_contrasts = {std::atof(argv[++i])};
         else if (!std::strcmp(argv[i], "--show") && i + 2 < argc) show_r = std::atof(argv[i + 1]), show_budget = std::uint32_t(std::atoi(argv[i + 2])), i += 2;
         else {
-            std::fprintf(stderr, "usage: fast_filter_fit [--write-header PATH] [--fis] [--show R N] [--check]\n");
+            std::fprintf(stderr, "usage: fast_filter_fit [--write-header PATH] [--fis] [--show R N] [--check] [--nearest] [--contrast C]\n");
             return 2;
         }
     }
