@@ -123,25 +123,32 @@ TEST_CASE("peak split: one bright texel filters to the closed-form kernel around
     const ibl::cubemap<float> src = point_light(n, b, p, 20, 41);
     const ibl::vec3<double> d = glm::normalize(ibl::cube_texel_direction<double>(4, 20, 41, n));
     const double energy = double(p - b) * ibl::cube_texel_solid_angle<double>(20, 41, n);
-    ibl::prefilter_options o = fast_options(16);
-    o.levels = 4;
-    const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
-    for (int l = 1; l < chain.levels(); ++l) {
-        const double r = o.policy.roughness(double(l), chain.levels());
-        const double norm = kernel_integral(r);
-        const int m = chain.size(l);
-        double e2 = 0.0, w2 = 0.0;
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < m; ++y)
-                for (int x = 0; x < m; ++x) {
-                    const ibl::vec3<double> R = glm::normalize(ibl::cube_texel_direction<double>(f, x, y, m));
-                    const double want = double(b) + energy * kernel(glm::dot(R, d), r) / norm;
-                    const double got = double(chain.texel(f, x, y, l).y);
-                    e2 += (got - want) * (got - want) / (want * want);
-                    w2 += 1.0;
-                }
-        CAPTURE(l);
-        CHECK(std::sqrt(e2 / w2) < 0.01);
+    // Without the coarse tail every level is the split's kernel alone; with it a level adds its
+    // share of the next level, read bilinearly at its texel centres (the interpolation of that
+    // coarser response adds its own error: 1.35 % at level 2, 16^2, reading 8^2).
+    for (const bool tail : {false, true}) {
+        ibl::prefilter_options o = fast_options(16);
+        o.levels = 4;
+        o.coarse_tail = tail;
+        const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
+        for (int l = 1; l < chain.levels(); ++l) {
+            const double r = o.policy.roughness(double(l), chain.levels());
+            const double norm = kernel_integral(r);
+            const int m = chain.size(l);
+            double e2 = 0.0, w2 = 0.0;
+            for (int f = 0; f < 6; ++f)
+                for (int y = 0; y < m; ++y)
+                    for (int x = 0; x < m; ++x) {
+                        const ibl::vec3<double> R = glm::normalize(ibl::cube_texel_direction<double>(f, x, y, m));
+                        const double want = double(b) + energy * kernel(glm::dot(R, d), r) / norm;
+                        const double got = double(chain.texel(f, x, y, l).y);
+                        e2 += (got - want) * (got - want) / (want * want);
+                        w2 += 1.0;
+                    }
+            CAPTURE(l);
+            CAPTURE(tail);
+            CHECK(std::sqrt(e2 / w2) < (tail ? 0.02 : 0.01));
+        }
     }
 }
 

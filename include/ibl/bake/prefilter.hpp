@@ -86,6 +86,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -163,6 +164,11 @@ struct prefilter_options {
     /// The fast filter's peak split (bake/prefilter_peaks.hpp): read by method = fast on a cubemap
     /// source with the GGX lobe only.
     peak_split_options peaks{};
+    /// The fast filter's coarse tail (bake/prefilter_fast.hpp, "Coarse tail"): each convolved
+    /// level but the last reads the heavy tail of its kernel from the finished next level (one
+    /// bilinear read per texel; the levels are filtered coarse to fine) and spends its tap set on
+    /// the rest. Read by method = fast only; false filters every level from the source alone.
+    bool coarse_tail = true;
 };
 
 /// Ceiling of the doubling sample schedule (samples per texel).
@@ -214,18 +220,19 @@ sphere_sample_table<S> make_ld_table(double roughness, std::uint32_t samples, Lo
 }
 
 /// The LD table of lobe L (GGX by default) of one level for a given source and options (the lod
-/// rule of the header comment). samples > limits::max_samples throws std::length_error.
+/// rule of the header comment). samples > limits::max_samples throws std::length_error. The fast
+/// filter's table with a next roughness >= 0 is that of its coarse tail (make_fast_ld_table).
 template <class S, class Lobe = ggx_lobe, class Env>
     requires ld_lobe<Lobe>
 sphere_sample_table<S> make_ld_table_for(const Env& env, double roughness, std::uint32_t samples,
                                          prefilter_method method, double lod_bias,
-                                         ld_weight weight = ld_weight::n_dot_l) {
+                                         ld_weight weight = ld_weight::n_dot_l, double next_roughness = -1.0) {
     detail::check_total("make_ld_table_for", "samples", samples, limits::max_samples, "limits::max_samples");
     using Te = std::conditional_t<environment<Env, float>, float, double>;
     if (method == prefilter_method::fast)
         return make_fast_ld_table<S, Lobe>(roughness, samples, fast_shape(roughness, samples, weight), [&](double omega) -> double {
             return double(env_lod_for_solid_angle<Te>(env, Te(omega)));
-        }, weight);
+        }, weight, next_roughness);
     return make_ld_table<S, Lobe>(roughness, samples, [&](double omega_s) -> double {
         if (method == prefilter_method::importance) return 0.0;
         // The bias b scales the footprint by 4^b: 0.5 log2(4^b Omega_s / Omega_0) = lod + b.
@@ -387,10 +394,49 @@ inline void check_prefilter_work(const prefilter_options& opt, const std::vector
 } // namespace detail
 
 namespace detail {
-/// A convolved level of a cubemap source: its taps and its peaks.
+/// The smallest face of a next level that a coarse tail reads (prefilter_options::coarse_tail):
+/// below it the bilinear read of the next level's coarse texels costs more accuracy than the tail
+/// saves (docs/ibl-bake.md, "Fast filter": a 256^2 chain's level 4, reading 8^2, is better without).
+inline constexpr int prefilter_coarse_tail_min_face = 16;
+/// The roughness of the level after plan level k that level k reads its coarse tail from
+/// (prefilter_options::coarse_tail: the fast filter, a convolved level with a next level of face
+/// >= prefilter_coarse_tail_min_face; output level 0 has face first_size), or -1.
+template <class Lobe> double prefilter_tail_roughness(const prefilter_options& opt, const std::vector<prefilter_level>& plan,
+                                                      std::size_t k, int first_size) {
+    if (opt.method != prefilter_method::fast || !opt.coarse_tail || k + 1 >= plan.size()) return -1.0;
+    if (lobe_mirror_limit<Lobe>() && plan[k].level == 0) return -1.0;
+    if (k + 1 >= 31 || (first_size >> (k + 1)) < prefilter_coarse_tail_min_face) return -1.0;
+    return std::clamp(std::isfinite(plan[k + 1].roughness) ? plan[k + 1].roughness : 0.0, 0.0, 1.0);
+}
+/// The order prefilter computes the plan's levels in: coarse to fine when a level reads its
+/// coarse tail, else fine to coarse.
+template <class Lobe>
+std::vector<std::size_t> prefilter_order(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int first_size) {
+    std::vector<std::size_t> order(plan.size());
+    bool tail = false;
+    for (std::size_t k = 0; k < plan.size(); ++k) tail = tail || prefilter_tail_roughness<Lobe>(opt, plan, k, first_size) >= 0.0;
+    for (std::size_t k = 0; k < plan.size(); ++k) order[k] = tail ? plan.size() - 1 - k : k;
+    return order;
+}
+/// A finished level as the next finer level reads it: one level of n x n texels (texel(f, x, y))
+/// with its borders, read bilinearly at the finer texel centres.
+template <class TexelFn> cubemap<float> prefilter_tail_cube(int n, TexelFn&& texel) {
+    cubemap<float> c(n, 1);
+    c.fill(0, [&](int f, int x, int y) { return vec3<float>(texel(f, x, y)); });
+    c.update_borders();
+    return c;
+}
+/// Adds share times the next level, read at the texel centres of row y of face `face` (n x n).
+inline void add_coarse_tail_row(const cubemap<float>& next, float share, int face, int y, int n, vec3<float>* out) {
+    const float t = (float(y) + 0.5f) / float(n);
+    for (int x = 0; x < n; ++x) out[x] += share * next.bilinear(face, (float(x) + 0.5f) / float(n), t, 0);
+}
+
+/// A convolved level of a cubemap source: its taps, its peaks and its coarse tail's share.
 struct prefilter_cube_level {
     tap_table taps{};
     peak_level peaks{};
+    float tail_share = 0.f; ///< > 0: the row adds this times the next level (prefilter_options::coarse_tail)
 };
 /// What prefilter reads from a cubemap source: the packed copy of the source (or of the base of
 /// its peak split), the split's peaks, and per level the taps and the merged peaks. The same
@@ -418,30 +464,38 @@ public:
         packed_ = pack_cube(src, ex);
         table_source_levels_ = src.levels();
     }
-    /// The taps of a plan level (tables from the source's lod mapping) and its peaks.
-    template <class Env> prefilter_cube_level level(const Env& env, const prefilter_level& lp) const {
+    /// The taps of a plan level (tables from the source's lod mapping), its peaks and its coarse
+    /// tail from the level of roughness next_roughness (< 0: none).
+    template <class Env> prefilter_cube_level level(const Env& env, const prefilter_level& lp, double next_roughness = -1.0) const {
         prefilter_cube_level lv;
-        sphere_sample_table<float> table =
-            make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight);
+        sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt_.method,
+                                                                          opt_.lod_bias, opt_.weight, next_roughness);
         table.trilinear = lp.trilinear;
         lv.taps = make_taps(table, int(packed_.levels.size()));
-        lv.peaks = level_peaks(lp);
+        lv.peaks = level_peaks(lp, next_roughness);
+        if (next_roughness >= 0.0) lv.tail_share = float(fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).share);
         return lv;
     }
-    /// The merged peaks of a plan level (empty without a split).
-    [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
+    /// The merged peaks of a plan level (empty without a split), with the coarse tail's kernel
+    /// removed when next_roughness >= 0.
+    [[nodiscard]] peak_level level_peaks(const prefilter_level& lp, double next_roughness = -1.0) const {
         if (peaks_.empty()) return {};
+        double c = 0.0;
+        if constexpr (std::is_same_v<Lobe, ggx_lobe>)
+            if (next_roughness >= 0.0) c = fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).c;
         return make_peak_level(peaks_, n0_, table_source_levels_, lp.roughness, opt_.weight, opt_.peaks.footprint,
-                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut);
+                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut, next_roughness, c);
     }
-    /// Row `row` (face n + y) of an n x n level.
-    void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out) const {
+    /// Row `row` (face n + y) of an n x n level; `next` is the next level (lv.tail_share > 0).
+    void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr) const {
         convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
         splat_peaks_row(lv.peaks, int(row) / n, int(row) % n, n, out);
+        if (next && lv.tail_share > 0.f) add_coarse_tail_row(*next, lv.tail_share, int(row) / n, int(row) % n, n, out);
     }
     [[nodiscard]] std::size_t peak_count() const noexcept { return peaks_.size(); }
 
 private:
+    static double clamped(double r) noexcept { return std::clamp(std::isfinite(r) ? r : 0.0, 0.0, 1.0); }
     prefilter_options opt_;
     int n0_ = 1, table_source_levels_ = 1;
     double mean_ = 0.0;
@@ -469,41 +523,57 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
     detail::check_prefilter_work(opt, plan, base);
     cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()));
+    // Coarse to fine when a level reads its coarse tail from the next (finished) level.
+    const std::vector<std::size_t> order = detail::prefilter_order<Lobe>(opt, plan, out.size(0));
+    std::optional<cubemap<float>> next; // the level after the one being computed, as its tail reads it
     if constexpr (requires { detail::pack_cube(env); }) {
         // Cubemap sources: one packed copy for every level, the peak split of the fast filter.
         const detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, ex);
-        for (int k = 0; k < int(plan.size()); ++k) {
-            const prefilter_level& lp = plan[std::size_t(k)];
-            const int n = out.size(k);
+        for (const std::size_t k : order) {
+            const prefilter_level& lp = plan[k];
+            const int n = out.size(int(k));
             // The rows are written in place: each work item owns whole face rows of the output.
             std::vector<vec3<float>*> rows(std::size_t(6 * n));
-            for (int r = 0; r < 6 * n; ++r) rows[std::size_t(r)] = &out.texel_ref(r / n, 0, r % n, k);
+            for (int r = 0; r < 6 * n; ++r) rows[std::size_t(r)] = &out.texel_ref(r / n, 0, r % n, int(k));
             if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
                 const detail::prefilter_base_read m = detail::prefilter_base_mode(env, n, lp.trilinear);
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
                     for (std::size_t row = b; row < e; ++row) detail::prefilter_base_row(env, n, m, row, rows[row]);
                 });
             } else {
-                const detail::prefilter_cube_level lv = cs.level(env, lp);
+                const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0));
+                const detail::prefilter_cube_level lv = cs.level(env, lp, rn);
+                const cubemap<float>* nx = rn >= 0.0 && next ? &*next : nullptr;
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row]);
+                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row], nx);
                 });
             }
+            if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0)) >= 0.0)
+                next = detail::prefilter_tail_cube(n, [&](int f, int x, int y) { return out.texel(f, x, y, int(k)); });
         }
     } else {
-        for (int k = 0; k < int(plan.size()); ++k) {
-            const prefilter_level& lp = plan[std::size_t(k)];
-            const int n = out.size(k);
+        for (const std::size_t k : order) {
+            const prefilter_level& lp = plan[k];
+            const int n = out.size(int(k));
             std::vector<vec3<float>> texels;
             if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
                 texels = detail::prefilter_base(env, n, lp.trilinear, ex);
             } else {
-                sphere_sample_table<float> table =
-                    make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt.method, opt.lod_bias, opt.weight);
+                const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0));
+                sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt.method,
+                                                                                  opt.lod_bias, opt.weight, rn);
                 table.trilinear = lp.trilinear;
                 texels = convolve_faces(env, table, n, ex);
+                if (rn >= 0.0 && next) {
+                    const float share = float(detail::fast_tail_of<Lobe>(std::clamp(std::isfinite(lp.roughness) ? lp.roughness : 0.0, 0.0, 1.0),
+                                                                  rn, opt.weight).share);
+                    for (int r = 0; r < 6 * n; ++r)
+                        detail::add_coarse_tail_row(*next, share, r / n, r % n, n, texels.data() + std::size_t(r) * std::size_t(n));
+                }
             }
-            out.fill(k, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
+            out.fill(int(k), [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
+            if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0)) >= 0.0)
+                next = detail::prefilter_tail_cube(n, [&](int f, int x, int y) { return texels[cube_texel_index(f, x, y, n)]; });
         }
     }
     out.update_borders();

@@ -47,10 +47,12 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <memory>
 #include <mutex>
 #include <span>
+#include <tuple>
 #include <type_traits>
 #include <utility>
 #include <vector>
@@ -119,7 +121,9 @@ struct fast_radial_cdf {
     std::vector<double> theta, cdf;
     double total = 0.0;
 };
-template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_weight weight) {
+/// The radial CDF of any kernel k(theta) >= 0 (negative values read as 0) on the grid of
+/// make_fast_radial_cdf for roughness r.
+template <class KernelFn> fast_radial_cdf make_radial_cdf_of(double roughness, KernelFn&& k) {
     constexpr int m = 4096;
     fast_radial_cdf c;
     const double lo = 1e-6 * fast_lobe_scale(roughness), hi = 0.5 * pi_v<double>;
@@ -128,7 +132,8 @@ template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_
     double prev_t = 0.0, prev_f = 0.0, acc = 0.0;
     for (int i = 0; i <= m; ++i) {
         const double t = lo * std::pow(hi / lo, double(i) / m);
-        const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t);
+        const double kv = k(t);
+        const double f = (kv > 0.0 ? kv : 0.0) * std::sin(t);
         acc += 0.5 * (f + prev_f) * (t - prev_t);
         c.theta.push_back(t);
         c.cdf.push_back(acc);
@@ -138,6 +143,10 @@ template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_
     for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
     return c;
 }
+template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_weight weight) {
+    return make_radial_cdf_of(roughness, [&](double t) { return fast_kernel<Lobe>(t, roughness, weight); });
+}
+
 /// The GGX lobe's radial CDF, memoised per (roughness, weight): a process-wide cache of at most 64
 /// entries (cleared when full) behind a mutex, so that a real-time caller who filters the same
 /// levels every frame does not rebuild the 4097-node quadrature per level and per call. Only the
@@ -159,6 +168,62 @@ inline std::shared_ptr<const fast_radial_cdf> ggx_fast_radial_cdf(double roughne
     return c;
 }
 
+/// The coarse tail of a level (header: "Coarse tail"): LD = (1 - share) [the tap set of
+/// K - c K_next] + share LD_next, c the largest multiple of the next level's kernel under this
+/// level's on the hemisphere (the minimum of K / K_next over the CDF's grid), share = 1 - the
+/// rest's integral / K's integral. c = share = 0 when the kernels give no bound.
+struct fast_coarse_tail {
+    double c = 0.0;
+    double share = 0.0;
+};
+/// A level's kernel with its coarse tail removed: the rest's radial CDF and the tail.
+struct fast_rest_kernel {
+    fast_radial_cdf cdf;
+    fast_coarse_tail tail;
+};
+template <class Lobe> fast_rest_kernel make_fast_rest_kernel(double roughness, double next_roughness, ld_weight weight) {
+    const fast_radial_cdf whole = make_fast_radial_cdf<Lobe>(roughness, weight);
+    double c = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 1; i < whole.theta.size(); ++i) {
+        const double k = fast_kernel<Lobe>(whole.theta[i], roughness, weight);
+        const double kn = fast_kernel<Lobe>(whole.theta[i], next_roughness, weight);
+        if (k > 0.0 && kn > 0.0) c = std::min(c, k / kn);
+    }
+    fast_rest_kernel r;
+    if (!std::isfinite(c) || !(c > 0.0) || !(whole.total > 0.0)) {
+        r.cdf = whole;
+        return r;
+    }
+    r.cdf = make_radial_cdf_of(roughness, [&](double t) {
+        return fast_kernel<Lobe>(t, roughness, weight) - c * fast_kernel<Lobe>(t, next_roughness, weight);
+    });
+    r.tail.c = c;
+    r.tail.share = std::clamp(1.0 - r.cdf.total / whole.total, 0.0, 1.0);
+    return r;
+}
+/// make_fast_rest_kernel of the GGX lobe, memoised per (roughness, next roughness, weight) as
+/// ggx_fast_radial_cdf.
+inline std::shared_ptr<const fast_rest_kernel> ggx_fast_rest_kernel(double roughness, double next_roughness, ld_weight weight) {
+    static std::mutex mutex;
+    static std::map<std::tuple<double, double, int>, std::shared_ptr<const fast_rest_kernel>> cache;
+    const std::tuple<double, double, int> key(roughness, next_roughness, int(weight));
+    {
+        const std::lock_guard<std::mutex> lock(mutex);
+        const auto it = cache.find(key);
+        if (it != cache.end()) return it->second;
+    }
+    auto c = std::make_shared<const fast_rest_kernel>(make_fast_rest_kernel<ggx_lobe>(roughness, next_roughness, weight));
+    const std::lock_guard<std::mutex> lock(mutex);
+    if (cache.size() >= 64) cache.clear();
+    cache.emplace(key, c);
+    return c;
+}
+/// The coarse tail of lobe L between two roughnesses (memoised for GGX).
+template <class Lobe> fast_coarse_tail fast_tail_of(double roughness, double next_roughness, ld_weight weight) {
+    if constexpr (std::is_same_v<Lobe, ggx_lobe>) return ggx_fast_rest_kernel(roughness, next_roughness, weight)->tail;
+    else return make_fast_rest_kernel<Lobe>(roughness, next_roughness, weight).tail;
+}
+
 /// The radius where the CDF reaches u (linear between grid points).
 inline double fast_cdf_at(const fast_radial_cdf& c, double u) noexcept {
     const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
@@ -174,35 +239,54 @@ inline double fast_cdf_at(const fast_radial_cdf& c, double u) noexcept {
 /// The fast filter's table of lobe L (GGX by default) for one roughness, sample count and shape
 /// (the header's spiral quadrature): tangent-space tap directions, kernel masses as weights, lods
 /// from lod_of_solid_angle(Omega_i 4^lod_bias). Computed in double, stored as S. samples = 0 reads
-/// as 1; a tail exponent that is not finite and > 0 reads as 1.
+/// as 1; a tail exponent that is not finite and > 0 reads as 1. With a next roughness (finite,
+/// >= 0; the header's "Coarse tail") the spiral is that of the kernel with its coarse tail
+/// removed and the table's scale is 1 - share: the caller adds share times the next level.
 template <class S, class Lobe = ggx_lobe, class LodFn>
     requires ld_lobe<Lobe>
 sphere_sample_table<S> make_fast_ld_table(double roughness, std::uint32_t samples, const fast_tap_shape& shape,
-                                          LodFn&& lod_of_solid_angle, ld_weight weight = ld_weight::n_dot_l) {
+                                          LodFn&& lod_of_solid_angle, ld_weight weight = ld_weight::n_dot_l,
+                                          double next_roughness = -1.0) {
     detail::check_total("make_fast_ld_table", "samples", samples, limits::max_samples, "limits::max_samples");
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
+    const bool tail_on = std::isfinite(next_roughness) && next_roughness >= 0.0;
+    const double rn = tail_on ? std::min(next_roughness, 1.0) : 0.0;
     const std::uint32_t n = std::max<std::uint32_t>(1, samples);
     const double tail = std::isfinite(shape.tail) && shape.tail > 0.0 ? shape.tail : 1.0;
     const double bias4 = std::exp2(2.0 * (std::isfinite(shape.lod_bias) ? shape.lod_bias : 0.0));
     std::shared_ptr<const detail::fast_radial_cdf> cdf_ptr;
-    if constexpr (std::is_same_v<Lobe, ggx_lobe>) cdf_ptr = detail::ggx_fast_radial_cdf(r, weight);
-    else cdf_ptr = std::make_shared<const detail::fast_radial_cdf>(detail::make_fast_radial_cdf<Lobe>(r, weight));
-    const detail::fast_radial_cdf& cdf = *cdf_ptr;
-    const double norm = 2.0 * pi_v<double> * cdf.total; // integral of K over the sphere
+    std::shared_ptr<const detail::fast_rest_kernel> rest_ptr;
+    detail::fast_coarse_tail ct{};
+    if (tail_on) {
+        if constexpr (std::is_same_v<Lobe, ggx_lobe>) rest_ptr = detail::ggx_fast_rest_kernel(r, rn, weight);
+        else rest_ptr = std::make_shared<const detail::fast_rest_kernel>(detail::make_fast_rest_kernel<Lobe>(r, rn, weight));
+        ct = rest_ptr->tail;
+    } else if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
+        cdf_ptr = detail::ggx_fast_radial_cdf(r, weight);
+    } else {
+        cdf_ptr = std::make_shared<const detail::fast_radial_cdf>(detail::make_fast_radial_cdf<Lobe>(r, weight));
+    }
+    const detail::fast_radial_cdf& cdf = tail_on ? rest_ptr->cdf : *cdf_ptr;
+    auto kernel = [&](double theta) {
+        const double k = detail::fast_kernel<Lobe>(theta, r, weight);
+        return ct.c > 0.0 ? k - ct.c * detail::fast_kernel<Lobe>(theta, rn, weight) : k;
+    };
+    const double norm = 2.0 * pi_v<double> * cdf.total; // integral of the (rest) kernel over the sphere
     constexpr double golden = 2.399963229728653;         // pi (3 - sqrt 5)
     auto warp = [&](double x) { return 1.0 - std::pow(1.0 - x, tail); };
     sphere_sample_table<S> t;
     t.drawn = n;
+    t.scale = S(1.0 - ct.share);
     for (std::uint32_t i = 0; i < n; ++i) {
         const double u0 = warp(double(i) / double(n)), u1 = i + 1 == n ? 1.0 : warp(double(i + 1) / double(n));
         const double mass = u1 - u0;
         const double theta = detail::fast_cdf_at(cdf, warp((double(i) + 0.5) / double(n)));
-        const double k = detail::fast_kernel<Lobe>(theta, r, weight);
+        const double k = kernel(theta);
         if (!(mass > 0.0) || !(k > 0.0) || !(norm > 0.0)) continue;
         const double omega = mass / (k / norm); // the sample's share of the sphere: its mass / density
         const double phi = golden * double(i);
-        const double st = std::sin(theta), ct = std::cos(theta);
-        t.push(vec3<S>(S(st * std::cos(phi)), S(st * std::sin(phi)), S(ct)), S(mass), S(lod_of_solid_angle(omega * bias4)));
+        const double st = std::sin(theta), ct_ = std::cos(theta);
+        t.push(vec3<S>(S(st * std::cos(phi)), S(st * std::sin(phi)), S(ct_)), S(mass), S(lod_of_solid_angle(omega * bias4)));
     }
     if (t.size() == 0) t.push(vec3<S>(S(0), S(0), S(1)), S(1), S(lod_of_solid_angle(0.0))); // a kernel with no mass: the mirror
     return t;

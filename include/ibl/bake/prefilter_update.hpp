@@ -72,10 +72,11 @@ public:
         else // the tables stay; the peaks of the fast filter's split belong to the source
             for (std::size_t k = 0; k < levels_.size(); ++k)
                 if (!levels_[k].mirror) {
-                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
+                    levels_[k].conv.peaks = src_->level_peaks(plan_[k], levels_[k].tail_roughness);
                     levels_[k].taps_per_row = convolved_row_taps(levels_[k]);
                 }
-        level_ = 0;
+        pos_ = 0;
+        level_ = order_.front();
         row_ = 0;
         pass_done_ = false;
     }
@@ -118,7 +119,8 @@ public:
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
         std::uint64_t t = std::uint64_t(6 * levels_[level_].n - int(row_)) * levels_[level_].taps_per_row;
-        for (std::size_t k = level_ + 1; k < levels_.size(); ++k) t += std::uint64_t(6 * levels_[k].n) * levels_[k].taps_per_row;
+        for (std::size_t p = pos_ + 1; p < order_.size(); ++p)
+            t += std::uint64_t(6 * levels_[order_[p]].n) * levels_[order_[p]].taps_per_row;
         return t;
     }
     /// The pass's plan (prefilter_plan of the options for this source).
@@ -137,13 +139,16 @@ private:
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
         detail::prefilter_base_read base{};  ///< the mirror level's read
         detail::prefilter_cube_level conv{}; ///< a convolved level's taps and peaks
+        double tail_roughness = -1.0;        ///< >= 0: reads its coarse tail from the next level
         std::uint64_t taps_per_row = 1;
         std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
+        std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
     };
 
     static std::uint64_t convolved_row_taps(const level_work& lw) noexcept {
-        return std::max<std::uint64_t>(
-            1, std::uint64_t(lw.n) * (lw.conv.taps.w.size() + (lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap));
+        return std::max<std::uint64_t>(1, std::uint64_t(lw.n) * (lw.conv.taps.w.size() +
+                                                                  (lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
+                                                                  (lw.conv.tail_share > 0.f ? 1u : 0u)));
     }
 
     void plan_levels() {
@@ -161,29 +166,42 @@ private:
                 lw.base = detail::prefilter_base_mode(*source_, lw.n, lp.trilinear);
                 lw.taps_per_row = std::uint64_t(lw.n);
             } else {
-                lw.conv = src_->level(*source_, lp);
+                lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_);
+                lw.conv = src_->level(*source_, lp, lw.tail_roughness);
                 lw.taps_per_row = convolved_row_taps(lw);
             }
             lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
             levels_.push_back(std::move(lw));
         }
+        order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
     template <class Executor> void run_rows(std::size_t begin, std::size_t end, Executor& ex) {
         level_work& lw = levels_[level_];
         const int n = lw.n;
+        const cubemap<float>* next =
+            lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next : nullptr;
         ex(end - begin, [&](std::size_t b, std::size_t e) {
             for (std::size_t r = begin + b; r < begin + e; ++r) {
                 vec3<float>* out = lw.texels.data() + r * std::size_t(n);
                 if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
-                else src_->row(lw.conv, r, n, out);
+                else src_->row(lw.conv, r, n, out, next);
             }
         });
     }
 
     void next_level() {
         row_ = 0;
-        if (++level_ < levels_.size()) return;
+        // The finished level as the coarse tail of the level before it in the plan.
+        if (level_ > 0 && levels_[level_ - 1].tail_roughness >= 0.0) {
+            const level_work& lw = levels_[level_];
+            levels_[level_].as_next =
+                detail::prefilter_tail_cube(lw.n, [&](int f, int x, int y) { return lw.texels[cube_texel_index(f, x, y, lw.n)]; });
+        }
+        if (++pos_ < order_.size()) {
+            level_ = order_[pos_];
+            return;
+        }
         cubemap<float> out(first_size_, int(levels_.size()));
         for (int k = 0; k < int(levels_.size()); ++k) {
             const level_work& lw = levels_[std::size_t(k)];
@@ -191,7 +209,8 @@ private:
         }
         out.update_borders();
         result_.emplace(std::move(out), opt_.weight, opt_.policy.mapping);
-        level_ = 0;
+        pos_ = 0;
+        level_ = order_.front();
         pass_done_ = true;
     }
 
@@ -201,7 +220,8 @@ private:
     std::vector<prefilter_level> plan_;
     std::vector<level_work> levels_;
     int first_size_ = 1;
-    std::size_t level_ = 0, row_ = 0;
+    std::vector<std::size_t> order_; ///< the levels in the order prefilter computes them
+    std::size_t pos_ = 0, level_ = 0, row_ = 0;
     bool pass_done_ = false;
     std::optional<specular_chain> result_;
 };
