@@ -17,7 +17,7 @@
 //    (12 gathers per tap), and the accumulators are per-channel batches.
 //  * rows:   the lane stage writes each lane's texel index and weights, then every lane blends its
 //    four float4 texels as 4-wide batches (RGB + padding), as the library's second lane loop does
-//    (x86 only: the 4-wide batch is xsimd's SSE4.2 one).
+//    (4-wide batches: SSE2 on x86, NEON on ARM; IBL_BENCH_XSIMD_ROWS says the variant exists).
 #include <ibl/batch/sphere_kernel.hpp>
 
 // GCC 12's AVX-512 intrinsics start from a self-initialised "undefined" vector
@@ -34,6 +34,17 @@
 #include <cstdint>
 
 namespace ibl_bench {
+
+#if XSIMD_WITH_SSE2
+#define IBL_BENCH_XSIMD_ROWS 1
+using xsimd_float4_arch = xsimd::sse2;
+#elif XSIMD_WITH_NEON64
+#define IBL_BENCH_XSIMD_ROWS 1
+using xsimd_float4_arch = xsimd::neon64;
+#elif XSIMD_WITH_NEON
+#define IBL_BENCH_XSIMD_ROWS 1
+using xsimd_float4_arch = xsimd::neon;
+#endif
 
 /// The lane stage of one tap for B texels: face-local bordered texel index of the (x0, y0) corner
 /// and the bilinear weights. Mirrors lane_cube_coord and convolve_lanes' first lane loop.
@@ -75,6 +86,16 @@ inline xsimd_tap_address<Arch> xsimd_address(const ibl::detail::packed_cube::lev
     return a;
 }
 
+/// A gather of B floats. xsimd 8.1's batch<float, A>::gather calls its kernel with explicit
+/// template arguments that the AVX2 and AVX-512 overloads do not take, so it always falls back to
+/// the generic element-by-element form (an extract, a scalar load and an insert per lane); where
+/// the instruction set has a gather, its kernel overload is called directly (found by deduction).
+template <class Arch>
+inline xsimd::batch<float, Arch> xsimd_gather(const float* src, const xsimd::batch<std::int32_t, Arch>& index) noexcept {
+    if constexpr (requires { xsimd::kernel::gather(src, index, Arch{}); }) return xsimd::kernel::gather(src, index, Arch{});
+    else return xsimd::batch<float, Arch>::gather(src, index);
+}
+
 /// How the xsimd kernel reads the texels (see the header comment).
 enum class xsimd_read { gather, rows };
 
@@ -105,8 +126,8 @@ void xsimd_convolve_lanes(const ibl::detail::packed_cube& src, const ibl::detail
                 const ib p = a.idx * 4, q = p + 4 * lv.stride; // float offsets of the top and bottom rows
                 const fb w(taps.w[i]);
                 for (int c = 0; c < 3; ++c) {
-                    const fb p0 = fb::gather(data + c, p), p1 = fb::gather(data + 4 + c, p);
-                    const fb q0 = fb::gather(data + c, q), q1 = fb::gather(data + 4 + c, q);
+                    const fb p0 = xsimd_gather<Arch>(data + c, p), p1 = xsimd_gather<Arch>(data + 4 + c, p);
+                    const fb q0 = xsimd_gather<Arch>(data + c, q), q1 = xsimd_gather<Arch>(data + 4 + c, q);
                     const fb top = p0 + a.wx * (p1 - p0);
                     const fb bot = q0 + a.wx * (q1 - q0);
                     blk[c] += w * (top + a.wy * (bot - top));
@@ -118,8 +139,9 @@ void xsimd_convolve_lanes(const ibl::detail::packed_cube& src, const ibl::detail
         for (int c = 0; c < 3; ++c) (tot[c] * taps.factor).store_aligned(r[c]);
         for (std::size_t k = 0; k < B; ++k) out[k] = ibl::vec3<float>(r[0][k], r[1][k], r[2][k]);
     } else {
-#if XSIMD_WITH_SSE4_2
-        using f4 = xsimd::batch<float, xsimd::sse4_2>; // one float4 texel (RGB + padding)
+#if defined(IBL_BENCH_XSIMD_ROWS)
+        using f4 = xsimd::batch<float, xsimd_float4_arch>; // one float4 texel (RGB + padding)
+        static_assert(f4::size == 4);
         f4 tot[B], blk[B];
         for (std::size_t k = 0; k < B; ++k) tot[k] = f4(0.f);
         alignas(64) std::int32_t idx[B];
@@ -153,7 +175,7 @@ void xsimd_convolve_lanes(const ibl::detail::packed_cube& src, const ibl::detail
             out[k] = ibl::vec3<float>(r[0], r[1], r[2]);
         }
 #else
-        static_assert(Read != xsimd_read::rows, "the rows variant needs 4-wide SSE batches");
+        static_assert(Read != xsimd_read::rows, "the rows variant needs 4-wide float batches");
 #endif
     }
 }
