@@ -22,7 +22,7 @@
 
 // GCC 12's AVX-512 intrinsics start from a self-initialised "undefined" vector
 // (_mm512_undefined_*: `__m512i __Y = __Y;`), which -Wmaybe-uninitialized reports wherever such an
-// intrinsic is inlined (GCC bug 105593, fixed in GCC 13). The false positive is silenced for the
+// intrinsic is inlined (GCC bug 105593). The false positive is silenced for the
 // intrinsic headers and this file only; the warning stays on for everything else.
 #if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic push
@@ -46,8 +46,8 @@ using xsimd_float4_arch = xsimd::neon64;
 using xsimd_float4_arch = xsimd::neon;
 #endif
 
-/// The lane stage of one tap for B texels: face-local bordered texel index of the (x0, y0) corner
-/// and the bilinear weights. Mirrors lane_cube_coord and convolve_lanes' first lane loop.
+/// The lane stage of one tap for B texels: the packed-source texel index of the (x0, y0) corner
+/// (bordered coordinates) and the bilinear weights. Mirrors lane_cube_coord and convolve_lanes' first lane loop.
 template <class Arch> struct xsimd_tap_address {
     using fb = xsimd::batch<float, Arch>;
     using ib = xsimd::batch<std::int32_t, Arch>;
