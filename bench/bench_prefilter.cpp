@@ -17,9 +17,13 @@
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/bake/prefilter_update.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
+#if defined(IBL_BENCH_XSIMD)
+#include "convolve_xsimd.hpp"
+#endif
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -217,34 +221,129 @@ template <std::size_t W> void convolve_level(const ibl::detail::packed_cube& src
     }
 }
 
+/// The case of BM_convolve_width and BM_convolve_xsimd: level 2 of the default chain on the sky
+/// with a sun, packed once per process.
+struct convolve_case {
+    int n = 0;
+    std::size_t samples = 0;
+    ibl::detail::packed_cube src;
+    ibl::detail::tap_table taps;
+};
+
+const convolve_case& convolve_setup() {
+    static const convolve_case* c = nullptr;
+    if (!c) {
+        const ibl::cubemap<float>& env = source(1);
+        const int level = 2;
+        auto* k = new convolve_case;
+        k->n = base >> level; // n = 64: a multiple of every lane width measured
+        const ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
+            env, ibl::roughness_mip_policy{}.roughness(double(level), 6),
+            ibl::default_prefilter_samples(ibl::prefilter_method::filtered_importance, level),
+            ibl::prefilter_method::filtered_importance, 0.5);
+        k->samples = table.size();
+        k->src = ibl::detail::pack_cube(env);
+        k->taps = ibl::detail::make_taps(table, int(k->src.levels.size()));
+        c = k;
+    }
+    return *c;
+}
+
+void set_tap_rate(benchmark::State& state, const convolve_case& c) {
+    state.counters["taps_per_s"] = benchmark::Counter(double(state.iterations()) * 6.0 * c.n * c.n * double(c.samples) * 2.0,
+                                                      benchmark::Counter::kIsRate);
+}
+
 void BM_convolve_width(benchmark::State& state) {
-    const ibl::cubemap<float>& env = source(1);
-    const int level = 2, n = base >> level; // n = 64: a multiple of the lane width
-    ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
-        env, ibl::roughness_mip_policy{}.roughness(double(level), 6), ibl::default_prefilter_samples(ibl::prefilter_method::filtered_importance, level),
-        ibl::prefilter_method::filtered_importance, 0.5);
-    const ibl::detail::packed_cube src = ibl::detail::pack_cube(env);
-    const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(src.levels.size()));
+    const convolve_case& c = convolve_setup();
+    const int n = c.n;
     std::vector<ibl::vec3<float>> out(std::size_t(6 * n * n)), scalar(out.size());
-    convolve_level<1>(src, taps, n, scalar);
+    convolve_level<1>(c.src, c.taps, n, scalar);
     for (auto _ : state) {
-        if (state.range(0) == 16) convolve_level<16>(src, taps, n, out);
-        else if (state.range(0) == 8) convolve_level<8>(src, taps, n, out);
-        else if (state.range(0) == 4) convolve_level<4>(src, taps, n, out);
-        else convolve_level<1>(src, taps, n, out);
+        if (state.range(0) == 16) convolve_level<16>(c.src, c.taps, n, out);
+        else if (state.range(0) == 8) convolve_level<8>(c.src, c.taps, n, out);
+        else if (state.range(0) == 4) convolve_level<4>(c.src, c.taps, n, out);
+        else convolve_level<1>(c.src, c.taps, n, out);
         benchmark::DoNotOptimize(out.data());
     }
     double diff = 0.0;
     for (std::size_t i = 0; i < out.size(); ++i)
-        for (int c = 0; c < 3; ++c) diff = std::max(diff, double(std::abs(out[i][c] - scalar[i][c])));
-    state.counters["taps_per_s"] = benchmark::Counter(double(state.iterations()) * 6.0 * n * n * double(table.size()) * 2.0,
-                                                      benchmark::Counter::kIsRate);
+        for (int c3 = 0; c3 < 3; ++c3) diff = std::max(diff, double(std::abs(out[i][c3] - scalar[i][c3])));
+    set_tap_rate(state, c);
     state.counters["max_abs_vs_width1"] = diff;
 }
+
+#if defined(IBL_BENCH_XSIMD)
+/// The same level with the kernel written in explicit xsimd batches (bench/convolve_xsimd.hpp, a
+/// bench-only alternative): range(0) the texel reads (0: gathers, 1: per-lane float4 rows),
+/// range(1) the instruction set (0: xsimd's default for the build, 1: AVX2, 8 lanes). Counters:
+/// taps per second, and the largest absolute and relative differences from the library's
+/// auto-vectorised convolve_row.
+template <class Arch, ibl_bench::xsimd_read Read>
+void xsimd_level(const convolve_case& c, std::vector<ibl::vec3<float>>& out) {
+    for (int row = 0; row < 6 * c.n; ++row)
+        ibl_bench::xsimd_convolve_row<Arch, Read>(c.src, c.taps, row / c.n, row % c.n, c.n,
+                                                  out.data() + std::size_t(row) * std::size_t(c.n));
+}
+
+template <class Arch> void run_xsimd(benchmark::State& state, const convolve_case& c, std::vector<ibl::vec3<float>>& out) {
+    const bool rows = state.range(0) != 0;
+    state.SetLabel(std::string(Arch::name()) + (rows ? " rows" : " gather") + ", " +
+                   std::to_string(xsimd::batch<float, Arch>::size) + " lanes");
+#if !defined(IBL_BENCH_XSIMD_ROWS)
+    if (rows) {
+        state.SkipWithError("no 4-wide float batches in this build");
+        return;
+    }
+#endif
+    for (auto _ : state) {
+#if defined(IBL_BENCH_XSIMD_ROWS)
+        if (rows) xsimd_level<Arch, ibl_bench::xsimd_read::rows>(c, out);
+        else
+#endif
+            xsimd_level<Arch, ibl_bench::xsimd_read::gather>(c, out);
+        benchmark::DoNotOptimize(out.data());
+    }
+}
+
+void BM_convolve_xsimd(benchmark::State& state) {
+    const convolve_case& c = convolve_setup();
+    const int n = c.n;
+    std::vector<ibl::vec3<float>> out(std::size_t(6 * n * n)), lib(out.size());
+    for (int row = 0; row < 6 * n; ++row)
+        ibl::detail::convolve_row(c.src, c.taps, row / n, row % n, n, lib.data() + std::size_t(row) * std::size_t(n));
+    if (state.range(1) == 0) run_xsimd<xsimd::default_arch>(state, c, out);
+    else {
+#if XSIMD_WITH_AVX2
+        run_xsimd<xsimd::avx2>(state, c, out);
+#else
+        state.SkipWithError("AVX2 is not enabled in this build");
+        return;
+#endif
+    }
+    double abs_diff = 0.0, rel_diff = 0.0;
+    for (std::size_t i = 0; i < out.size(); ++i)
+        for (int c3 = 0; c3 < 3; ++c3) {
+            const double d = std::abs(double(out[i][c3]) - double(lib[i][c3]));
+            abs_diff = std::max(abs_diff, d);
+            if (lib[i][c3] != 0.f) rel_diff = std::max(rel_diff, d / std::abs(double(lib[i][c3])));
+        }
+    set_tap_rate(state, c);
+    state.counters["max_abs_vs_row"] = abs_diff;
+    state.counters["max_rel_vs_row"] = rel_diff;
+}
+#endif
 
 } // namespace
 
 BENCHMARK(BM_convolve_width)->ArgName("W")->Arg(1)->Arg(4)->Arg(8)->Arg(16)->Unit(benchmark::kMillisecond)->UseRealTime();
+#if defined(IBL_BENCH_XSIMD)
+BENCHMARK(BM_convolve_xsimd)
+    ->ArgNames({"rows", "avx2"})
+    ->ArgsProduct({{0, 1}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+#endif
 BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget"})->ArgsProduct({{1}, {16, 18, 20}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)
