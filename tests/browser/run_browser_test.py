@@ -569,7 +569,8 @@ def compare_prefilter(fixtures, result):
                 if bad < 3:
                     print(f"  {name} value {i}: GLSL {g!r} C++ {e!r}")
                 bad += 1
-        print(f"{name} ({lv['n']}^2 x 6, {lv['count']} taps, {lv['peak_count']} peaks): worst |diff| / (2^-11 |C++|) "
+        tail = f", coarse tail {lv['tail_share']:.4g} of the {lv['next_n']}^2 next level" if lv.get("tail_share", 0) > 0 else ""
+        print(f"{name} ({lv['n']}^2 x 6, {lv['count']} taps, {lv['peak_count']} peaks{tail}): worst |diff| / (2^-11 |C++|) "
               f"{worst:.3g}, {bad} values outside")
         ok = ok and bad == 0
     # The viewer's live path (tools/viewer/refilter.js): its packing and taps against the C++ ones,
@@ -590,10 +591,13 @@ def compare_prefilter(fixtures, result):
     for lv, d in zip(fixtures["levels"], result["taps"]):
         print(f"viewer taps, level {lv['level']} ({lv['weight']}): {d}")
         ok = ok and "max_abs" in d and d["max_abs"] <= 1e-5 and abs(d["factor"] - d["expected_factor"]) <= 1e-6 * abs(d["expected_factor"])
+        # the coarse tail's share of the next level (0 without one)
+        ok = ok and abs(d.get("tail_share", -1) - d.get("expected_tail_share", 0)) <= 1e-6
     for lv, d in zip(fixtures["levels"], result["peaks"]):
         print(f"viewer peaks, level {lv['level']} ({lv['weight']}): {d} (C++ {lv['peak_count']} peaks)")
         ok = ok and d.get("count") == lv["peak_count"] and "dir_max_abs" in d and d["dir_max_abs"] <= 1e-6 and \
-            d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"]
+            d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"] and \
+            abs(d.get("tail_m", -1) - d.get("expected_tail_m", 0)) <= 1e-6 * max(d.get("expected_tail_m", 0), 1e-30)
     by_level = {(lv["level"], lv["weight"]): lv for lv in result["js_levels"]}
     for lv in fixtures["levels"]:
         got = by_level.get((lv["level"], lv["weight"]))

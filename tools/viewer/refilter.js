@@ -59,19 +59,20 @@ function foldBorder(face, x, y, n) {
 // ---- the packed source ------------------------------------------------------------------------------
 
 /// Packs level 0 (six faces of n x n RGB(A) texels, `rgbOf(face, x, y)` -> [r, g, b]) with its
-/// full mip chain (power-of-two n): { data: Float32Array (4 per texel), levels: [{n, stride,
+/// full mip chain (power-of-two n; at most maxLevels levels: 1 packs one level with its border, as
+/// the coarse tail's next level is read): { data: Float32Array (4 per texel), levels: [{n, stride,
 /// faceStride, offset}] }, the layout of ibl::detail::pack_cube. With `peaks` (splitPeaks' list)
 /// it packs the split's base as split_cube_peaks makes it: the mips of the source, then each
 /// peak's level-0 texel scaled to the threshold and, on every coarser level, the peak's energy over
 /// the covering texel's solid angle taken out (clamped at 0), the peaks in list order.
-export function packSource(n, rgbOf, peaks = null) {
+export function packSource(n, rgbOf, peaks = null, maxLevels = Infinity) {
     if (!(n >= 1) || (n & (n - 1)) !== 0) throw new Error(`re-filtering needs a power-of-two face, got ${n}`);
     const levels = [];
     let total = 0;
     for (let m = n; ; m >>= 1) {
         levels.push({ n: m, stride: m + 2, faceStride: (m + 2) * (m + 2), offset: total });
         total += 6 * (m + 2) * (m + 2);
-        if (m === 1) break;
+        if (m === 1 || levels.length >= maxLevels) break;
     }
     const data = new Float32Array(4 * total);
     const at = (lv, f, x, y) => 4 * (lv.offset + f * lv.faceStride + (y + 1) * lv.stride + (x + 1));
@@ -178,13 +179,13 @@ function kernel(theta, r, weight) {
     return Number.isFinite(k) && k > 0 ? k : 0;
 }
 
-/// The radial CDF of the kernel at roughness r (detail::make_fast_radial_cdf): { th, cdf, total }.
-function radialCdf(r, weight) {
+/// The radial CDF of a kernel k(theta) on the grid of roughness r (detail::make_radial_cdf_of): { th, cdf, total }.
+function radialCdfOf(r, k) {
     const m = 4096, lo = 1e-6 * 2 * Math.atan(Math.max(r * r, 1e-3)), hi = 0.5 * Math.PI;
     const th = [0], cdf = [0];
     let pt = 0, pf = 0, acc = 0;
     for (let i = 0; i <= m; ++i) {
-        const t = lo * Math.pow(hi / lo, i / m), f = kernel(t, r, weight) * Math.sin(t);
+        const t = lo * Math.pow(hi / lo, i / m), kv = k(t), f = (kv > 0 ? kv : 0) * Math.sin(t);
         acc += 0.5 * (f + pf) * (t - pt);
         th.push(t);
         cdf.push(acc);
@@ -193,16 +194,39 @@ function radialCdf(r, weight) {
     for (let i = 0; i < cdf.length; ++i) cdf[i] = acc > 0 ? cdf[i] / acc : 0;
     return { th, cdf, total: acc };
 }
+/// The radial CDF of the kernel at roughness r (detail::make_fast_radial_cdf).
+function radialCdf(r, weight) {
+    return radialCdfOf(r, (t) => kernel(t, r, weight));
+}
+
+/// The coarse tail (detail::make_fast_rest_kernel): c = the least K / K_next over the CDF's grid,
+/// the rest K - c K_next's CDF, share = 1 - its integral / K's. { cdf, c, share } (c = share = 0:
+/// no bound, the whole kernel).
+export function restKernel(r, rn, weight) {
+    const whole = radialCdf(r, weight);
+    let c = Infinity;
+    for (let i = 1; i < whole.th.length; ++i) {
+        const k = kernel(whole.th[i], r, weight), kn = kernel(whole.th[i], rn, weight);
+        if (k > 0 && kn > 0) c = Math.min(c, k / kn);
+    }
+    if (!Number.isFinite(c) || !(c > 0) || !(whole.total > 0)) return { cdf: whole, c: 0, share: 0 };
+    const cdf = radialCdfOf(r, (t) => kernel(t, r, weight) - c * kernel(t, rn, weight));
+    return { cdf, c, share: Math.min(1, Math.max(0, 1 - cdf.total / whole.total)) };
+}
 
 /// Taps of one level: { taps: Float32Array (x, y, z, w per tap), info: Float32Array (n, stride,
 /// face stride, offset per tap), count, factor }, the tables ibl_prefilter.glsl reads.
-export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
+export function fastTaps(rows, roughness, samples, weight, trilinear, packed, nextRoughness = -1) {
     const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
     const n = Math.max(1, samples >>> 0);
     const shape = fastShape(rows, r, n, weight);
     const tail = Number.isFinite(shape.tail) && shape.tail > 0 ? shape.tail : 1;
     const bias4 = Math.pow(2, 2 * shape.bias);
-    const { th, cdf, total: acc } = radialCdf(r, weight);
+    // With a next roughness: the coarse tail's rest kernel, scale 1 - share (make_fast_ld_table).
+    const rn = Number.isFinite(nextRoughness) && nextRoughness >= 0 ? Math.min(1, nextRoughness) : -1;
+    const rest = rn >= 0 ? restKernel(r, rn, weight) : { cdf: radialCdf(r, weight), c: 0, share: 0 };
+    const { th, cdf, total: acc } = rest.cdf;
+    const kern = (t) => { const k = kernel(t, r, weight); return rest.c > 0 ? k - rest.c * kernel(t, rn, weight) : k; };
     const at = (u) => {
         let a = 0, b = cdf.length; // lower_bound
         while (a < b) { const c = (a + b) >> 1; if (cdf[c] < u) a = c + 1; else b = c; }
@@ -218,7 +242,7 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
     const samplesOut = [];
     for (let i = 0; i < n; ++i) {
         const u0 = warp(i / n), u1 = i + 1 === n ? 1 : warp((i + 1) / n), mass = u1 - u0;
-        const theta = at(warp((i + 0.5) / n)), k = kernel(theta, r, weight);
+        const theta = at(warp((i + 0.5) / n)), k = kern(theta);
         if (!(mass > 0) || !(k > 0) || !(norm > 0)) continue;
         const phi = 2.399963229728653 * i, st = Math.sin(theta), ct = Math.cos(theta);
         samplesOut.push([Math.fround(st * Math.cos(phi)), Math.fround(st * Math.sin(phi)), Math.fround(ct), Math.fround(mass),
@@ -245,7 +269,9 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed) {
         for (let i = b; i < Math.min(b + 32, taps.length / 4); ++i) part = Math.fround(part + taps[4 * i + 3]);
         total = Math.fround(total + part);
     }
-    return { taps: new Float32Array(taps), info: new Float32Array(info), count: taps.length / 4, factor: total > 0 ? Math.fround(1 / total) : 0 };
+    const scale = Math.fround(1 - rest.share);
+    return { taps: new Float32Array(taps), info: new Float32Array(info), count: taps.length / 4,
+             factor: total > 0 ? Math.fround(scale / total) : 0, tail_share: Math.fround(rest.share), tail_c: rest.c };
 }
 
 // ---- the peak split (include/ibl/bake/prefilter_peaks.hpp) ----------------------------------------
@@ -342,8 +368,8 @@ function peakMergeMip(r, n0, maxMip, footprint, maxAngle) {
 /// make_peak_level: a level's peaks for ibl_prefilter_peaks (the split's peaks of an n0-texel level 0
 /// with `sourceLevels` mips, merged at peakMergeMip, energies pre-scaled by alpha^2 / (4 pi
 /// integral K)): { peak_count, peaks: Float32Array (x, y, z, er, eg, eb per peak), a2, g1 }.
-export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults) {
-    const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false };
+export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults, nextRoughness = -1, tailC = 0) {
+    const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false, b2: 0, tail_m: 0 };
     if (!peaks.length) return none;
     const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
     const a = Math.max(r * r, 1e-4), a2 = a * a;
@@ -356,5 +382,12 @@ export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = 
         out.set(p.dir, 6 * j);
         for (let k = 0; k < 3; ++k) out[6 * j + 3 + k] = p.energy[k] * scale;
     });
-    return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1' };
+    // The coarse tail's rest kernel: tail_m = c b2 / a2 (make_peak_level with a next roughness).
+    let b2 = 0, tailM = 0;
+    if (Number.isFinite(nextRoughness) && nextRoughness >= 0 && Number.isFinite(tailC) && tailC > 0) {
+        const b = Math.max(Math.min(1, nextRoughness) ** 2, 1e-4);
+        b2 = b * b;
+        tailM = tailC * b2 / a2;
+    }
+    return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1', b2: Math.fround(b2), tail_m: Math.fround(tailM) };
 }

@@ -304,17 +304,20 @@ function floatTexture(gl, unit, w, h, values) {
 
 /// The packed source (refilter.js packSource, or the C++ packing) as the RGBA32F texture
 /// ibl_prefilter.glsl reads on unit 0, `width` texels per row.
-function packedTexture(gl, data, width) {
+function packedTexture(gl, data, width, unit = 0) {
     const height = Math.ceil(data.length / 4 / width), all = new Float32Array(4 * width * height);
     all.set(data);
-    return floatTexture(gl, 0, width, height, all);
+    return floatTexture(gl, unit, width, height, all);
 }
 
 /// The passes of ibl_prefilter.glsl, one per face of each level: the packed source bound on unit 0;
 /// per level { n, count, factor, taps, info } its taps uploaded on unit 1 and, with { peak_count,
-/// peaks (px, py, pz, er, eg, eb per peak), a2, g1 } (the peak split, make_peak_level), its peaks
-/// on unit 3 (a 1 x 2 zero texture without); target(level, face) binds the framebuffer's attachment
-/// before a pass, done(level, face) runs after it. Returns the textures it made (the caller deletes them).
+/// peaks (px, py, pz, er, eg, eb per peak), a2, g1, b2, tail_m } (the peak split, make_peak_level),
+/// its peaks on unit 3 (a 1 x 2 zero texture without), and with { tail_share > 0, next } the coarse
+/// tail: next() (called when the level's turn comes, after the earlier levels' done) returns
+/// { n, data } the next level packed with its border (refilter.js packSource(n, rgbOf, null, 1)),
+/// uploaded on unit 4. target(level, face) binds the framebuffer's attachment before a pass,
+/// done(level, face) runs after it. Returns the textures it made (the caller deletes them).
 function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     const u = (name) => gl.getUniformLocation(program, name);
     gl.useProgram(program);
@@ -322,8 +325,16 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     gl.uniform1i(u('u_src'), 0);
     gl.uniform1i(u('u_taps'), 1);
     gl.uniform1i(u('u_peaks'), 3);
+    gl.uniform1i(u('u_next'), 4);
     const made = [];
     for (const lv of levels) {
+        const share = lv.tail_share > 0 ? lv.tail_share : 0;
+        const next = share > 0 ? lv.next() : { n: 1, data: new Float32Array(8) };
+        made.push(packedTexture(gl, next.data, 256, 4));
+        gl.uniform1i(u('u_next_n'), next.n);
+        gl.uniform1f(u('u_tail_share'), share);
+        gl.uniform1f(u('u_peak_b2'), share > 0 && lv.b2 ? lv.b2 : 0);
+        gl.uniform1f(u('u_tail_m'), share > 0 && lv.tail_m ? lv.tail_m : 0);
         const both = new Float32Array(8 * lv.count);
         both.set(lv.taps);
         both.set(lv.info, 4 * lv.count);
@@ -406,8 +417,9 @@ class Renderer {
     /// (ibl_prefilter.glsl: refilter.js splits level 0's peaks off as the C++ prefilter does with its
     /// default peak_split_options, packs the split's base with its mips and builds each level's taps
     /// at the level's roughness from report.json, 32 * 2^(v - 1) samples at virtual level v,
-    /// trilinear reads, the chain's LD weight, and its merged peaks) and renders every face of every
-    /// level into the chain texture. Returns { prepare_ms (split, packing, taps and peaks, CPU),
+    /// trilinear reads, the chain's LD weight, its merged peaks and its coarse tail) and renders
+    /// every face of every level into the chain texture, coarse to fine (a level's coarse tail reads
+    /// the next level back from the GPU and packs it). Returns { prepare_ms (split, packing, taps and peaks, CPU),
     /// gpu_ms (the passes, to gl.finish), levels, peaks (level-0 peaks) }.
     refilter(prefilterFragment, shapesText) {
         const gl = this.gl, bake = this.bake, chain = bake.chain;
@@ -427,18 +439,35 @@ class Renderer {
         const shapes = parseFastShapes(shapesText);
         const weight = spec.ld_weight === 'g1' ? 'g1' : 'nl';
         const plan = [];
+        const convolved = (k) => k > 0 && k < chain.levels.length && spec.levels[k] && spec.levels[k].virtual_level > 0;
         spec.levels.forEach((lv, k) => {
-            if (k === 0 || !(lv.virtual_level > 0) || k >= chain.levels.length) return;
+            if (!convolved(k)) return;
             const samples = Math.min(16384, 32 * 2 ** (lv.virtual_level - 1));
-            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed),
-                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight) });
+            // The coarse tail (prefilter_options::coarse_tail): from the next level when its face is >= 16.
+            const rn = convolved(k + 1) && chain.levels[k + 1].size >= 16 ? spec.levels[k + 1].roughness : -1;
+            const taps = fastTaps(shapes, lv.roughness, samples, weight, true, packed, rn);
+            plan.push({ k, n: chain.levels[k].size, ...taps,
+                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight, undefined, rn, taps.tail_c) });
         });
+        plan.sort((a, b) => b.k - a.k); // coarse to fine: a coarse tail reads the finished next level
+        const done = new Map(); // level k -> its faces read back (RGBA floats), for the level before it
+        for (const lv of plan)
+            lv.next = () => {
+                const m = chain.levels[lv.k + 1].size, faces = done.get(lv.k + 1);
+                return { n: m, data: packSource(m, (f, x, y) => { const i = 4 * (y * m + x); return [faces[f][i], faces[f][i + 1], faces[f][i + 2]]; }, null, 1).data };
+            };
         const t1 = performance.now();
         const srcTex = packedTexture(gl, packed.data, 4096);
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
         const made = prefilterPasses(gl, this.prefilterProgram, this.vao, plan, (lv, f) =>
-            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k));
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k), (lv, f) => {
+            if (!plan.some((p) => p.k === lv.k - 1 && p.tail_share > 0)) return;
+            const px = new Float32Array(4 * lv.n * lv.n);
+            gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
+            if (!done.has(lv.k)) done.set(lv.k, []);
+            done.get(lv.k)[f] = px;
+        });
         gl.finish();
         const t2 = performance.now();
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -700,15 +729,19 @@ async function runPrefilterTest() {
         packedDiffBase = Math.max(packedDiffBase, d / Math.max(1e-30, Math.abs(fx.packed[k])));
     }
     const shapes = parseFastShapes(await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
-    const jsTaps = fx.levels.map((lv) => fastTaps(shapes, lv.roughness, lv.samples, lv.weight, lv.trilinear, js));
+    // A level with a coarse tail (tail_share > 0) has its next level's roughness in the fixtures.
+    const nextR = (lv) => (lv.tail_share > 0 ? lv.next_roughness : -1);
+    const jsTaps = fx.levels.map((lv) => fastTaps(shapes, lv.roughness, lv.samples, lv.weight, lv.trilinear, js, nextR(lv)));
     const tapsDiff = fx.levels.map((lv, i) => {
         const t = jsTaps[i];
         if (t.count !== lv.count) return { count: t.count, expected: lv.count };
         let d = 0;
         for (let k = 0; k < 4 * lv.count; ++k) d = Math.max(d, Math.abs(t.taps[k] - lv.taps[k]), Math.abs(t.info[k] - lv.info[k]));
-        return { max_abs: d, factor: t.factor, expected_factor: lv.factor };
+        return { max_abs: d, factor: t.factor, expected_factor: lv.factor, tail_share: t.tail_share,
+                 expected_tail_share: lv.tail_share || 0 };
     });
-    const jsPeaks = fx.levels.map((lv) => makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight));
+    const jsPeaks = fx.levels.map((lv, i) =>
+        makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight, undefined, nextR(lv), jsTaps[i].tail_c));
     const peaksDiff = fx.levels.map((lv, i) => {
         const p = jsPeaks[i];
         if (p.peak_count !== lv.peak_count || p.g1 !== lv.g1) return { count: p.peak_count, expected: lv.peak_count };
@@ -718,10 +751,11 @@ async function runPrefilterTest() {
             if (j % 6 < 3) dir = Math.max(dir, d);
             else energy = Math.max(energy, d / Math.max(1e-30, Math.abs(lv.peaks[j])));
         }
-        return { count: p.peak_count, dir_max_abs: dir, energy_max_rel: energy, a2: p.a2, expected_a2: lv.a2 };
+        return { count: p.peak_count, dir_max_abs: dir, energy_max_rel: energy, a2: p.a2, expected_a2: lv.a2,
+                 tail_m: p.tail_m, expected_tail_m: lv.tail_m || 0 };
     });
     // Each level into an RGBA32F target, read back face by face (rows from y = 0: the chain's order).
-    const render = (levels) => {
+    const render = (levels, finished = () => {}) => {
         const out = [];
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
@@ -738,15 +772,29 @@ async function runPrefilterTest() {
             const px = new Float32Array(4 * lv.n * lv.n);
             gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
             for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(px[4 * k], px[4 * k + 1], px[4 * k + 2]);
-            if (f === 5) out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
+            if (f === 5) {
+                out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
+                finished(out[out.length - 1]);
+            }
         });
         return out;
     };
+    // The C++ inputs, the coarse tail's next level included (the C++ chain's, packed as it reads it).
     packedTexture(gl, Float32Array.from(fx.packed), fx.width);
-    const levels = render(fx.levels);
-    // The whole live path: the viewer's packing and taps through the same shader.
+    const levels = render(fx.levels.map((lv) => ({ ...lv, next: () => ({ n: lv.next_n, data: Float32Array.from(lv.next_packed) }) })));
+    // The whole live path: the viewer's packing and taps through the same shader, the levels coarse
+    // to fine, each coarse tail reading the GPU's own next level (read back and packed by packSource).
+    const mine = new Map();
+    const ordered = fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] }))
+        .sort((a, b) => (a.weight === b.weight ? b.level - a.level : a.weight < b.weight ? -1 : 1));
+    for (const lv of ordered)
+        lv.next = () => {
+            const nx = mine.get(`${lv.weight}/${lv.level + 1}`);
+            const m = nx.n, at = (f, x, y) => { const k = 3 * ((f * m + y) * m + x); return [nx.rgb[k], nx.rgb[k + 1], nx.rgb[k + 2]]; };
+            return { n: m, data: packSource(m, at, null, 1).data };
+        };
     packedTexture(gl, js.data, fx.width);
-    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] })));
+    const jsLevels = render(ordered, (r) => mine.set(`${r.weight}/${r.level}`, r));
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
                  packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff,
                  source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });
