@@ -204,7 +204,7 @@ lobe_tables tabulate_lobe(const char* fn, const py::object& model, std::vector<d
 }
 
 py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std::string& method, const std::string& weight,
-                   unsigned threads, py::object model, py::object peaks) {
+                   unsigned threads, py::object model, py::object peaks, bool coarse_tail) {
     const bool py_lobe = is_python_lobe("prefilter", model);
     ibl::prefilter_options opt;
     if (method == "fis") opt.method = ibl::prefilter_method::filtered_importance;
@@ -217,6 +217,7 @@ py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std
     if (levels < -1) throw py::value_error("ibl.prefilter: levels must be -1 (automatic), 0 (full chain) or positive");
     opt.levels = levels;
     opt.samples = samples;
+    opt.coarse_tail = coarse_tail;
     // The fast filter's peak split (bake/prefilter_peaks.hpp) needs the closed-form GGX kernel: on
     // by default for the built-in lobe, off for a Python model (asking for it there is an error).
     if (!peaks.is_none()) {
@@ -661,7 +662,7 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
 void bind_env(py::module_& m) {
     m.def("prefilter", &prefilter, py::arg("cube"), py::kw_only(), py::arg("levels") = -1, py::arg("samples") = 0u,
           py::arg("method") = "fis", py::arg("weight") = "n_dot_l", py::arg("threads") = 0u, py::arg("model") = py::none(),
-          py::arg("peaks") = py::none(),
+          py::arg("peaks") = py::none(), py::arg("coarse_tail") = true,
           "The prefiltered specular chain of ibl::prefilter (N = V = R): a list of float32 arrays\n"
           "(6, s, s, 3), level l of face size max(1, n >> l) for roughness l / (levels - 1).\n"
           "cube: (6, n, n, 3), faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0. levels: -1\n"
@@ -672,7 +673,8 @@ void bind_env(py::module_& m) {
           "tabulated from one vectorised ndf call on a fine grid of n.h per level roughness\n"
           "(weight 'n_dot_l' only). peaks: the fast filter's peak split, at most this many source texels\n"
           "taken out of the tap set and added back through the closed-form GGX kernel (None = 1024 for\n"
-          "the built-in lobe, off for a Python model; 0 = off).");
+          "the built-in lobe, off for a Python model; 0 = off). coarse_tail: the fast filter reads each\n"
+          "level's kernel tail from the finished next level (prefilter_options::coarse_tail; True by default).");
     m.def("irradiance", &irradiance, py::arg("cube"), py::arg("size") = 32, py::kw_only(), py::arg("samples") = 1024u,
           py::arg("method") = "cosine", py::arg("threads") = 0u,
           "Irradiance cube (6, size, size, 3) float32 of ibl::irradiance_cubemap: E(n) at every texel\n"

@@ -170,3 +170,24 @@ def test_fast_filter_peak_split_builtin_only():
         ibl.prefilter(cube, method="fast", model=GGXHeightCorrelated(), peaks=8)
     with pytest.raises(ValueError, match="peaks"):
         ibl.prefilter(cube, method="fast", peaks=-1)
+
+
+def test_fast_filter_coarse_tail():
+    # a 64^2 cube (5 levels): level 1 reads its kernel tail from level 2 (16^2), level 2 would read
+    # 8^2 (below the 16-texel minimum) and is the tap set alone either way
+    n = 64
+    cube = np.ones((6, n, n, 3), np.float32)
+    cube[2] *= 20.0  # a bright +Y face over dim ones
+    on = ibl.prefilter(cube, method="fast", samples=16, threads=1, peaks=0)
+    off = ibl.prefilter(cube, method="fast", samples=16, threads=1, peaks=0, coarse_tail=False)
+    assert len(on) == 5
+    assert not np.array_equal(on[1], off[1])
+    for k in (0, 2, 3, 4):
+        assert np.array_equal(on[k], off[k])
+    # a white furnace stays exactly white with the tail (its share and the rest's add to 1)
+    white = ibl.prefilter(np.ones((6, n, n, 3), np.float32), method="fast", samples=16, threads=1)
+    assert all(np.allclose(level, 1.0, rtol=0, atol=1e-6) for level in white)
+    # the option is read by the fast filter only
+    fis_on = ibl.prefilter(cube, method="fis", samples=16, threads=1)
+    fis_off = ibl.prefilter(cube, method="fis", samples=16, threads=1, coarse_tail=False)
+    assert all(np.array_equal(a, b) for a, b in zip(fis_on, fis_off))
