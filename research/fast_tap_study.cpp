@@ -187,6 +187,8 @@ struct design {
     bool reuse = false;
     double tail = 1.0, bias = 0.0;
     std::uint32_t n0 = 0;
+    double max_share = 1.0; ///< coarse tail: the largest share of the kernel read from the next level
+    bool library = false;   ///< ibl::prefilter itself (method fast, no peak split, coarse_tail = reuse)
 };
 
 /// Per level of the chain, the rel RMSE of luminance at the reference texels and the taps.
@@ -204,6 +206,29 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
                         ibl::ld_weight w, ibl::thread_executor& ex) {
     chain_result res;
     res.err.assign(chain_levels, 0.0);
+    if (d.library) {
+        ibl::prefilter_options o;
+        o.method = ibl::prefilter_method::fast;
+        o.levels = chain_levels;
+        o.samples_per_level.assign(std::size_t(chain_levels), 0u);
+        for (int l = 1; l < chain_levels; ++l) o.samples_per_level[std::size_t(l)] = doubling(d.n0, l);
+        o.samples = d.n0;
+        o.weight = w;
+        o.peaks.enabled = false;
+        o.coarse_tail = d.reuse;
+        const ibl::specular_chain ch = ibl::prefilter(cube, o, ex);
+        for (int l = 1; l < chain_levels; ++l) {
+            const int n = ch.size(l);
+            std::vector<vec3<float>> out(std::size_t(6 * n * n));
+            for (int f = 0; f < 6; ++f)
+                for (int y = 0; y < n; ++y)
+                    for (int x = 0; x < n; ++x) out[ibl::cube_texel_index(f, x, y, n)] = ch.texel(f, x, y, l);
+            res.err[std::size_t(l)] = rel_rmse(out, n, refs[std::size_t(l)]);
+            const auto t = ibl::make_ld_table_for<float>(cube, level_r(l), doubling(d.n0, l), ibl::prefilter_method::fast, 0.0, w);
+            res.taps += 6.0 * n * n * double(t.size() + (d.reuse && (n / 2) >= ibl::detail::prefilter_coarse_tail_min_face ? 1 : 0));
+        }
+        return res;
+    }
     ibl::cubemap<float> next(1, 1); // the coarser level just computed (coarse-tail designs)
     for (int l = chain_levels - 1; l >= 1; --l) {
         const int n = base_size >> l;
@@ -219,9 +244,12 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
                 if (K1(t) > 0 && K0(t) > 0) c = std::min(c, K0(t) / K1(t));
             }
             const kernel_tab k0 = tabulate(K0, r), k1 = tabulate(K1, r1);
+            c = std::min(c, d.max_share * k0.total / k1.total);
             const kernel_tab rest = tabulate([&](double t) { return K0(t) - c * K1(t); }, r);
             const double a_rest = rest.total / k0.total, a_next = c * k1.total / k0.total;
-            const auto t = spiral_table(cube, rest, doubling(d.n0, l), d.tail, d.bias, false);
+            const std::uint32_t ns = doubling(d.n0, l);
+            const ibl::fast_tap_shape fs = ibl::fast_shape(r, ns, w);
+            const auto t = d.tail > 0 ? spiral_table(cube, rest, ns, d.tail, d.bias, false) : spiral_table(cube, rest, ns, fs.tail, fs.lod_bias, false);
             res.taps += 6.0 * n * n * double(t.size() + 1);
             const auto tex = ibl::convolve_faces(cube, t, n, ex);
             out.resize(tex.size());
@@ -272,6 +300,9 @@ int main(int argc, char** argv) {
                                t.trilinear = false;
                                return t;
                            }});
+        if (!quick) {
+            designs.push_back({"ibl::prefilter fast, coarse tail (the default), " + std::to_string(n0), nullptr, true, 0.0, 0.0, n0, 1.0, true});
+        }
     }
     for (std::uint32_t n0 : {16u, 32u, 64u, 128u}) {
         if (quick && n0 > 16) break;

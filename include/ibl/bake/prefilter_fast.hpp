@@ -31,6 +31,24 @@
 // Each row records filtered importance sampling's error at the same N: the fitted shapes are
 // below it at 239 of the 240 rows (within 1.2% at the other: g1, r = 0.7, N = 8).
 //
+// Coarse tail (prefilter_options::coarse_tail, on by default). The GGX LD kernel's tail is heavy
+// (K ~ alpha^2 / theta^4 for theta >> alpha: at r = 0.2 a sixth of its mass lies beyond 0.2 rad),
+// so a small tap set either spends most of its samples far from the core or reads the tail from
+// coarse mips that leak whatever is bright nearby (a sky into a dark ground). The next level of
+// the chain, LD_next = integral L K_next / Z_next, already holds that tail: with
+//     c = min over theta in (0, pi/2] of K(theta) / K_next(theta),     K_rest = K - c K_next >= 0,
+//     LD(R) = (Z_rest / Z) [integral L K_rest / Z_rest](R) + (c Z_next / Z) LD_next(R),
+// (Z the integrals over the hemisphere; the two weights add to 1, share = c Z_next / Z), and
+// for n.l the minimum is at theta = pi/2, c = (a^2 / b^2) ((1 + b^2) / (1 + a^2))^2 (a, b the two
+// alphas), so K_rest falls as a^2 b^2 / theta^6: its mass beyond theta is O(a^2 b^2 / theta^4)
+// against O(a^2 / theta^2) for K. The tap set is the spiral of K_rest (its radial CDF, the same
+// shapes) with scale 1 - share, the peak split uses K_rest in closed form (prefilter_peaks.hpp),
+// and LD_next is one bilinear read of the finished next level at the texel centre (the levels are
+// filtered coarse to fine). A level reads its tail only from a next level of face >= 16
+// (prefilter_coarse_tail_min_face): the bilinear read of coarser texels costs more than the tail
+// saves. Measured (research/fast_tap_study.cpp, docs/ibl-bake.md "Fast filter"): on two HDRIs it
+// lowers levels 1-3 of a 256^2 chain by 1.1-2x at the same samples.
+//
 // Cost: N samples per texel (one bilinear tap each from the nearest level, the default plan's
 // reads; two with trilinear reads), the default schedule fast_default_samples * 2^(l - 1) against
 // 512 * 2^(l - 1) trilinear samples for filtered importance sampling.

@@ -4,13 +4,15 @@
 //
 // A renderer that re-filters a probe at run time (a captured reflection probe, a sky that changes
 // with the time of day) cannot spend a whole prefilter in one frame. prefilter_update holds the
-// work of one prefilter(source, opt) as a sequence of face rows, level by level (the plan of
-// prefilter_plan: mirror level 0 first, then the rough levels), and step(budget) computes rows
+// work of one prefilter(source, opt) as a sequence of face rows, level by level in prefilter's
+// order (prefilter_plan's levels from the mirror level 0 to the roughest, or the reverse when the
+// fast filter's coarse tail reads each level's next: detail::prefilter_order), and step(budget) computes rows
 // until the next row would exceed `budget` source reads ("taps"); a row costs
 //     n_l           taps on a mirror level 0 (one read per texel),
-//     n_l (S_l T_l + ceil(P_l / 8))   taps on a convolved level (S_l samples kept after dropping
-//                   n.l <= 0, T_l = 2 for trilinear reads, 1 for nearest; P_l the peaks of the
-//                   fast filter's split at that level, bake/prefilter_peaks.hpp, eight to a tap),
+//     n_l (S_l T_l + ceil(P_l / 8) + C_l)   taps on a convolved level (S_l samples kept after
+//                   dropping n.l <= 0, T_l = 2 for trilinear reads, 1 for nearest; P_l the peaks of
+//                   the fast filter's split at that level, bake/prefilter_peaks.hpp, eight to a
+//                   tap; C_l = 1 with a coarse tail, its read of the next level),
 // so the cost of a call is bounded by max(budget, the dearest row) and proportional to the taps it
 // reports (bench/bench_prefilter.cpp, BM_prefilter_update_step). Every row is computed by exactly
 // the operations prefilter uses (the same tables, the same kernel, the same row order of
@@ -24,8 +26,9 @@
 // fast filter's peaks (bake/prefilter_peaks.hpp) are split again from each new source.
 //
 // Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
-// level) and pack it into the kernel's layout (passes over its texels); the last step of a pass assembles the chain's cubemap
-// and its borders (one pass over the output texels). Both are linear and small next to the
+// level) and pack it into the kernel's layout (passes over its texels); a finished level that a
+// coarse tail reads is copied with its borders (one pass over its texels); the last step of a pass
+// assembles the chain's cubemap and its borders (one pass over the output texels). All are linear and small next to the
 // convolution (hundreds of taps per texel).
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of

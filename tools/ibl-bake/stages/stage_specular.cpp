@@ -280,7 +280,8 @@ void specular_stage::report(json_writer& j) const {
     j.key("prefilter").value(to_string(method_));
     j.key("method").value(std::string(method_ == prefilter_choice::fast
                                           ? std::string("GGX fast filter (ibl::prefilter_method::fast: spiral tap sets shaped offline, "
-                                                        "read from the exact-solid-angle mips") +
+                                                        "read from the exact-solid-angle mips; coarse tail: each level's kernel tail "
+                                                        "read from the next level of face >= 16") +
                                                 (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel), "
                                                            : "), ")
                                           : "GGX filtered importance sampling (Krivanek-Colbert), ") +
