@@ -105,62 +105,26 @@ ibl::sphere_sample_table<float> polar_table(const ibl::cubemap<float>& cube, dou
     return t;
 }
 
-
+/// A kernel and its radial CDF (ibl::detail::make_radial_cdf_of on the grid of roughness r).
 struct kernel_tab {
-    std::vector<double> theta, cdf, k;
-    double total = 0;
+    ibl::detail::fast_radial_cdf cdf;
+    std::function<double(double)> k;
+    [[nodiscard]] double total() const { return cdf.total; }
 };
-// Tabulates K (any function of theta) on the grid of make_fast_radial_cdf, with its radial CDF.
-template <class K> kernel_tab tabulate(K&& kf, double r) {
-    constexpr int m = 4096;
-    kernel_tab c;
-    const double lo = 1e-6 * ibl::fast_lobe_scale(r), hi = 0.5 * M_PI;
-    c.theta.push_back(0.0);
-    c.cdf.push_back(0.0);
-    c.k.push_back(kf(0.0));
-    double prev_t = 0.0, prev_f = 0.0, acc = 0.0;
-    for (int i = 0; i <= m; ++i) {
-        const double t = lo * std::pow(hi / lo, double(i) / m);
-        const double kv = std::max(0.0, kf(t));
-        const double f = kv * std::sin(t);
-        acc += 0.5 * (f + prev_f) * (t - prev_t);
-        c.theta.push_back(t);
-        c.cdf.push_back(acc);
-        c.k.push_back(kv);
-        prev_t = t, prev_f = f;
-    }
-    c.total = acc;
-    for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
-    return c;
-}
-double tab_inv(const kernel_tab& c, double u) {
-    const auto it = std::lower_bound(c.cdf.begin(), c.cdf.end(), u);
-    if (it == c.cdf.begin()) return 0.0;
-    if (it == c.cdf.end()) return c.theta.back();
-    const std::size_t k = std::size_t(it - c.cdf.begin());
-    const double d = c.cdf[k] - c.cdf[k - 1];
-    const double f = d > 0.0 ? (u - c.cdf[k - 1]) / d : 0.0;
-    return c.theta[k - 1] + f * (c.theta[k] - c.theta[k - 1]);
-}
-double tab_k(const kernel_tab& c, double t) {
-    auto it = std::lower_bound(c.theta.begin(), c.theta.end(), t);
-    if (it == c.theta.begin()) return c.k.front();
-    if (it == c.theta.end()) return c.k.back();
-    const std::size_t i = std::size_t(it - c.theta.begin());
-    const double f = (t - c.theta[i - 1]) / (c.theta[i] - c.theta[i - 1]);
-    return c.k[i - 1] + f * (c.k[i] - c.k[i - 1]);
+template <class K> kernel_tab tabulate(K kf, double r) {
+    return {ibl::detail::make_radial_cdf_of(r, kf), std::function<double(double)>(kf)};
 }
 ibl::sphere_sample_table<float> spiral_table(const ibl::cubemap<float>& cube, const kernel_tab& c, std::uint32_t n,
                                              double tail, double bias, bool tri) {
-    const double norm = 2.0 * M_PI * c.total;
+    const double norm = 2.0 * M_PI * c.total();
     auto warp = [&](double x) { return 1.0 - std::pow(1.0 - x, tail); };
     ibl::sphere_sample_table<float> t;
     t.trilinear = tri;
     for (std::uint32_t i = 0; i < n; ++i) {
         const double u0 = warp(double(i) / n), u1 = i + 1 == n ? 1.0 : warp(double(i + 1) / n);
         const double mass = u1 - u0;
-        const double theta = tab_inv(c, warp((i + 0.5) / n));
-        const double k = tab_k(c, theta);
+        const double theta = ibl::detail::fast_cdf_at(c.cdf, warp((i + 0.5) / n));
+        const double k = c.k(theta);
         if (!(mass > 0) || !(k > 0)) continue;
         const double omega = mass / (k / norm);
         const double phi = 2.399963229728653 * i;
@@ -244,9 +208,9 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
                 if (K1(t) > 0 && K0(t) > 0) c = std::min(c, K0(t) / K1(t));
             }
             const kernel_tab k0 = tabulate(K0, r), k1 = tabulate(K1, r1);
-            c = std::min(c, d.max_share * k0.total / k1.total);
+            c = std::min(c, d.max_share * k0.total() / k1.total());
             const kernel_tab rest = tabulate([&](double t) { return K0(t) - c * K1(t); }, r);
-            const double a_rest = rest.total / k0.total, a_next = c * k1.total / k0.total;
+            const double a_rest = rest.total() / k0.total(), a_next = c * k1.total() / k0.total();
             const std::uint32_t ns = doubling(d.n0, l);
             const ibl::fast_tap_shape fs = ibl::fast_shape(r, ns, w);
             const auto t = d.tail > 0 ? spiral_table(cube, rest, ns, d.tail, d.bias, false) : spiral_table(cube, rest, ns, fs.tail, fs.lod_bias, false);
