@@ -130,6 +130,20 @@ TEST_CASE("fast prefilter: a white furnace returns exactly 1 on every level") {
     }
 }
 
+TEST_CASE("fast prefilter: a white furnace that is not a cubemap returns 1 with the coarse tail (generic path)") {
+    // Sources without texels take the generic evaluator; the coarse tail then adds the finished
+    // next level to convolve_faces' result (64^2: level 1 reads its tail from level 2, 16^2).
+    const ibl::constant_environment<float> white{ibl::vec3<float>(1.f)};
+    for (ibl::ld_weight w : {ibl::ld_weight::n_dot_l, ibl::ld_weight::g1}) {
+        ibl::prefilter_options o = fast_options(8);
+        o.base_size = 64;
+        o.weight = w;
+        const ibl::specular_chain ch = ibl::prefilter(white, o, ibl::serial_executor{});
+        for (int l = 0; l < ch.levels(); ++l)
+            for (int f = 0; f < 6; ++f) CHECK(ch.texel(f, ch.size(l) / 2, 0, l).x == doctest::Approx(1.0).epsilon(1e-6));
+    }
+}
+
 TEST_CASE("fast prefilter: within a few percent of the exact LD on a smooth sky, at both weights") {
     ibl::sky_environment<double> sky = ibl::make_default_sky<double>();
     sky.sun_radiance = ibl::vec3<double>(0.0); // the smooth part: the sun is tested below
