@@ -117,15 +117,17 @@ void BM_prefilter_fis(benchmark::State& state) { run_sweep(state, ibl::prefilter
 /// nearest-level reads as the FIS sweep: the error-vs-time frontier of the two side by side.
 void BM_prefilter_fast(benchmark::State& state) { run_sweep(state, ibl::prefilter_method::fast); }
 
-/// The fast filter with and without its peak split (bake/prefilter_peaks.hpp), nearest reads,
-/// range(1) samples at level 1 doubled per level (the default schedule's shape), at face size
-/// range(3) (256 or 128): the real-time end of the frontier. args: env, spp, peaks, size.
+/// The fast filter with and without its peak split (bake/prefilter_peaks.hpp) and its coarse tail
+/// (prefilter_options::coarse_tail), nearest reads, range(1) samples at level 1 doubled per level
+/// (the default schedule's shape), at face size range(3) (256 or 128): the real-time end of the
+/// frontier. args: env, spp, peaks, size, tail.
 void BM_prefilter_fast_split(benchmark::State& state) {
     ibl::prefilter_options o;
     o.levels = levels;
     o.method = ibl::prefilter_method::fast;
     for (int l = 0; l < levels; ++l) o.samples_per_level.push_back(std::uint32_t(state.range(1)) << (l > 0 ? l - 1 : 0));
     o.peaks.enabled = state.range(2) != 0;
+    o.coarse_tail = state.range(4) != 0;
     run_chain(state, o, int(state.range(0)), int(state.range(3)));
 }
 
@@ -358,8 +360,8 @@ BENCHMARK(BM_prefilter_fast)
     ->UseRealTime();
 BENCHMARK(BM_prefilter_fast_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fast_split)
-    ->ArgNames({"env", "spp", "peaks", "size"})
-    ->ArgsProduct({{1}, {4, 8, 16, 32, 64}, {0, 1}, {128, 256}})
+    ->ArgNames({"env", "spp", "peaks", "size", "tail"})
+    ->ArgsProduct({{1}, {4, 8, 16, 32, 64}, {0, 1}, {128, 256}, {0, 1}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_prefilter_is)
