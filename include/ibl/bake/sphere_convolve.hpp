@@ -116,6 +116,8 @@ template <class S> tap_table make_taps(const sphere_sample_table<S>& table, int 
     const float total = tap_weight_sum(t); // the kernel's blocked order
     const float norm = table.normalised ? total : 1.f;
     t.factor = norm > 0.f ? float(table.scale) / norm : 0.f;
+    t.scale = float(table.scale);
+    t.normalised = table.normalised;
     return t;
 }
 

@@ -8,17 +8,21 @@
 // frame of output direction k, l_i the tap directions (tangent space, z = dir), w_i > 0 the tap
 // weights, factor = scale / norm (norm = tap_weight_sum in the kernel's order, or 1).
 //
-//  * packed_cube: the source copied once into a bordered float4 layout (RGB + padding), levels one
-//    after the other; non-finite components are stored as 0.
+//  * packed_cube: the source copied once into a bordered float4 layout (RGB + a fourth channel of
+//    1), levels one after the other; non-finite components are stored as 0.
 //  * tap_table: bilinear taps on single levels (the integrator splits a sample with fractional lod
 //    into taps on floor(lod) and floor(lod) + 1: the trilinear lookup), so the kernel reads exactly
 //    one level per tap and the level's size, strides and offset are loop invariants.
 //  * convolve_lanes<W>: W output texels of one face row. Per tap, lane loop 1 rotates the tap
 //    direction into each texel's frame, selects the face branch-free (lane_cube_coord) and forms
 //    the bilinear address and weights (vectorisable); lane loop 2 reads the 2 x 2 texels and
-//    accumulates. Accumulation is in float in blocks of tap_block taps whose sums are added to the
-//    totals (error ~ (tap_block + taps / tap_block) eps instead of taps * eps); tap_weight_sum is
-//    the normaliser in the same blocked order, so a source of ones returns exactly 1.
+//    accumulates, the four channels of a texel as one 4-wide operation. Accumulation is in float
+//    in blocks of tap_block taps whose sums are added to the totals (error ~ (tap_block + taps /
+//    tap_block) eps instead of taps * eps). The fourth channel (1 in every texel; its blend is
+//    exactly 1) sums the tap weights in that order: tap_weight_sum, bit for bit, and the
+//    normaliser of a normalised table, so a source of ones returns exactly 1. (That channel is
+//    what keeps the blend 4-wide: a padding channel whose sum went unused was dropped by the
+//    compiler, which then split the three live channels into a 2-wide and a scalar part.)
 //  * convolve_row: one face row in chunks of convolve_width lanes, the tail at width 1.
 // Determinism: every output texel is a fixed sequence of operations on the taps and the source.
 
@@ -42,8 +46,8 @@ namespace detail {
 /// Taps per accumulation block of the fast path (see the header comment).
 inline constexpr std::size_t tap_block = 32;
 
-/// A cubemap copied into float4 texels (RGB + padding), every face with its 1-texel border,
-/// levels one after the other. Non-finite components are stored as 0.
+/// A cubemap copied into float4 texels (RGB + 1: the kernel's weight channel), every face with
+/// its 1-texel border, levels one after the other. Non-finite components are stored as 0.
 struct packed_cube {
     struct level {
         int n = 1;           ///< face size
@@ -53,7 +57,7 @@ struct packed_cube {
         float nf = 1.f;      ///< float(n)
     };
     std::vector<level> levels;
-    std::vector<float> data; ///< 4 floats per texel
+    std::vector<float> data; ///< 4 floats per texel: R, G, B, 1
 };
 
 /// The packed copy of c; the face rows of every level are copied through the executor (a plain
@@ -87,6 +91,7 @@ template <class T, class Executor = serial_executor> packed_cube pack_cube(const
             for (int x = -1; x <= li.n; ++x, q += 4) {
                 const vec3<T>& v = c.texel(f, x, y, int(l));
                 for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
+                q[3] = 1.f;
             }
         }
     });
@@ -97,12 +102,14 @@ template <class T, class Executor = serial_executor> packed_cube pack_cube(const
 struct tap_table {
     std::vector<float> x, y, z, w;
     std::vector<int> level;
-    float factor = 1.f; ///< scale / norm, norm summed in the kernel's blocked order
+    float factor = 1.f;      ///< scale / norm, norm summed in the kernel's blocked order
+    float scale = 1.f;       ///< the table's scale
+    bool normalised = false; ///< norm = tap_weight_sum (else 1)
 };
 
 /// Sum of the tap weights in the kernel's order (block partial sums of tap_block taps added to the
-/// total, as convolve_lanes accumulates), so that factor = scale / tap_weight_sum makes a source of
-/// ones return exactly scale.
+/// total, as convolve_lanes accumulates its weight channel, which equals this bit for bit), so that
+/// factor = scale / tap_weight_sum makes a source of ones return exactly scale.
 inline float tap_weight_sum(const tap_table& t) noexcept {
     float total = 0.f;
     for (std::size_t b = 0; b < t.w.size(); b += tap_block) {
@@ -140,7 +147,9 @@ IBL_FUNC_VOID void lane_cube_coord(float dx, float dy, float dz, int& face, floa
     t = t0 > 0.f ? (t0 < 1.f ? t0 : 1.f) : 0.f;
 }
 
-/// Convolves W output directions (one chunk of a face row): out[k] = factor * sum w L.
+/// Convolves W output directions (one chunk of a face row): out[k] = factor * sum w L, factor
+/// computed per lane from its weight channel for a normalised table (the same float division as
+/// make_taps', on the same sum: the same bits as taps.factor).
 template <std::size_t W>
 void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, vec3<float>* out) noexcept {
     float tot[W][4], blk[W][4];
@@ -176,7 +185,7 @@ void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_fr
                 idx[k] = off + face * fs + y0 * st + x0;
             }
             // Lane loop 2: bilinear blend (a + w (b - a), exact on equal texels) and accumulate,
-            // four channels at a time (RGB + padding).
+            // four channels at a time (RGB + the weight channel).
             for (std::size_t k = 0; k < W; ++k) {
                 const float* p = data + 4 * std::size_t(idx[k]);
                 const float* q = p + 4 * std::size_t(st);
@@ -191,8 +200,11 @@ void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_fr
         for (std::size_t k = 0; k < W; ++k)
             for (int c = 0; c < 4; ++c) tot[k][c] += blk[k][c];
     }
-    for (std::size_t k = 0; k < W; ++k)
-        out[k] = vec3<float>(tot[k][0] * taps.factor, tot[k][1] * taps.factor, tot[k][2] * taps.factor);
+    for (std::size_t k = 0; k < W; ++k) {
+        // tot[k][3] == tap_weight_sum(taps); reading it keeps the fourth channel (see the header).
+        const float f = taps.normalised ? (tot[k][3] > 0.f ? taps.scale / tot[k][3] : 0.f) : taps.factor;
+        out[k] = vec3<float>(tot[k][0] * f, tot[k][1] * f, tot[k][2] * f);
+    }
 }
 
 /// Lane width of the fast path (a face row is processed in chunks of W, the tail at width 1).
