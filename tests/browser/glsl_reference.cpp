@@ -922,8 +922,8 @@ void print_prefilter_fixtures() {
         for (std::size_t l = 0; l < plan.size(); ++l) {
             const ibl::prefilter_level& lp = plan[l];
             if (lp.level == 0) continue; // the mirror level is a copy
-            // The coarse tail (prefilter_options::coarse_tail): the rest kernel's taps and peaks, and
-            // the next level of the C++ chain as the row kernel reads it (prefilter_tail_cube, packed).
+            // The coarse tail (prefilter_options::coarse_tail): the rest kernel's taps and the share of
+            // the next level (the GPU reads its own next level before its peaks, as the C++ does).
             const double rn = ibl::detail::prefilter_tail_roughness<ibl::ggx_lobe>(o, plan, l, size);
             const ibl::detail::fast_coarse_tail tail =
                 rn >= 0.0 ? ibl::detail::fast_tail_of<ibl::ggx_lobe>(lp.roughness, rn, o.weight) : ibl::detail::fast_coarse_tail{};
@@ -950,19 +950,12 @@ void print_prefilter_fixtures() {
                 split.empty() ? ibl::peak_level{}
                               : ibl::make_peak_level(split.peaks, size, base.levels(), lp.roughness, o.weight,
                                                      o.peaks.footprint, o.peaks.max_merge_angle, split.mean_luminance,
-                                                     o.peaks.cut, rn, tail.c);
-            std::printf("], \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"b2\": %.9g, \"tail_m\": %.9g, "
-                        "\"next_roughness\": %.17g, \"tail_share\": %.9g, \"tail_c\": %.17g",
-                        pl.size(), double(pl.a2), pl.g1 ? "true" : "false", double(pl.b2), double(pl.tail_m), rn,
-                        double(float(tail.share)), tail.c);
-            const int nn = l + 1 < plan.size() ? chain.size(int(l) + 1) : 1;
-            std::printf(", \"next_n\": %d, \"next_packed\": [", nn);
-            if (rn >= 0.0) {
-                const ibl::cubemap<float> next = ibl::detail::prefilter_tail_cube(nn, [&](int f, int x, int y) { return chain.texel(f, x, y, int(l) + 1); });
-                const ibl::detail::packed_cube pn = ibl::detail::pack_cube(next);
-                for (std::size_t k = 0; k < pn.data.size(); ++k) std::printf("%s%.9g", k ? ", " : "", double(pn.data[k]));
-            }
-            std::printf("], \"peaks\": [");
+                                                     o.peaks.cut);
+            std::printf("], \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"next_roughness\": %.17g, \"tail_share\": %.9g, "
+                        "\"next_n\": %d",
+                        pl.size(), double(pl.a2), pl.g1 ? "true" : "false", rn, double(float(tail.share)),
+                        l + 1 < plan.size() ? chain.size(int(l) + 1) : 0);
+            std::printf(", \"peaks\": [");
             for (std::size_t j = 0; j < pl.size(); ++j)
                 std::printf("%s%.9g, %.9g, %.9g, %.9g, %.9g, %.9g", j ? ", " : "", double(pl.px[j]), double(pl.py[j]),
                             double(pl.pz[j]), double(pl.er[j]), double(pl.eg[j]), double(pl.eb[j]));

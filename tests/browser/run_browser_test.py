@@ -596,8 +596,7 @@ def compare_prefilter(fixtures, result):
     for lv, d in zip(fixtures["levels"], result["peaks"]):
         print(f"viewer peaks, level {lv['level']} ({lv['weight']}): {d} (C++ {lv['peak_count']} peaks)")
         ok = ok and d.get("count") == lv["peak_count"] and "dir_max_abs" in d and d["dir_max_abs"] <= 1e-6 and \
-            d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"] and \
-            abs(d.get("tail_m", -1) - d.get("expected_tail_m", 0)) <= 1e-6 * max(d.get("expected_tail_m", 0), 1e-30)
+            d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"]
     by_level = {(lv["level"], lv["weight"]): lv for lv in result["js_levels"]}
     for lv in fixtures["levels"]:
         got = by_level.get((lv["level"], lv["weight"]))

@@ -368,8 +368,8 @@ function peakMergeMip(r, n0, maxMip, footprint, maxAngle) {
 /// make_peak_level: a level's peaks for ibl_prefilter_peaks (the split's peaks of an n0-texel level 0
 /// with `sourceLevels` mips, merged at peakMergeMip, energies pre-scaled by alpha^2 / (4 pi
 /// integral K)): { peak_count, peaks: Float32Array (x, y, z, er, eg, eb per peak), a2, g1 }.
-export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults, nextRoughness = -1, tailC = 0) {
-    const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false, b2: 0, tail_m: 0 };
+export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults) {
+    const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false };
     if (!peaks.length) return none;
     const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
     const a = Math.max(r * r, 1e-4), a2 = a * a;
@@ -382,12 +382,5 @@ export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = 
         out.set(p.dir, 6 * j);
         for (let k = 0; k < 3; ++k) out[6 * j + 3 + k] = p.energy[k] * scale;
     });
-    // The coarse tail's rest kernel: tail_m = c b2 / a2 (make_peak_level with a next roughness).
-    let b2 = 0, tailM = 0;
-    if (Number.isFinite(nextRoughness) && nextRoughness >= 0 && Number.isFinite(tailC) && tailC > 0) {
-        const b = Math.max(Math.min(1, nextRoughness) ** 2, 1e-4);
-        b2 = b * b;
-        tailM = tailC * b2 / a2;
-    }
-    return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1', b2: Math.fround(b2), tail_m: Math.fround(tailM) };
+    return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1' };
 }

@@ -312,12 +312,13 @@ function packedTexture(gl, data, width, unit = 0) {
 
 /// The passes of ibl_prefilter.glsl, one per face of each level: the packed source bound on unit 0;
 /// per level { n, count, factor, taps, info } its taps uploaded on unit 1 and, with { peak_count,
-/// peaks (px, py, pz, er, eg, eb per peak), a2, g1, b2, tail_m } (the peak split, make_peak_level),
+/// peaks (px, py, pz, er, eg, eb per peak), a2, g1 } (the peak split, make_peak_level),
 /// its peaks on unit 3 (a 1 x 2 zero texture without), and with { tail_share > 0, next } the coarse
 /// tail: next() (called when the level's turn comes, after the earlier levels' done) returns
-/// { n, data } the next level packed with its border (refilter.js packSource(n, rgbOf, null, 1)),
-/// uploaded on unit 4. target(level, face) binds the framebuffer's attachment before a pass,
-/// done(level, face) runs after it. Returns the textures it made (the caller deletes them).
+/// { n, data } the next level before its peaks (the shader's second output) packed with its border
+/// (refilter.js packSource(n, rgbOf, null, 1)), uploaded on unit 4. target(level, face) binds the
+/// framebuffer's attachments before a pass (the second, when bound, receives the texel before its
+/// peaks), done(level, face) runs after it. Returns the textures it made (the caller deletes them).
 function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     const u = (name) => gl.getUniformLocation(program, name);
     gl.useProgram(program);
@@ -333,8 +334,6 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
         made.push(packedTexture(gl, next.data, 256, 4));
         gl.uniform1i(u('u_next_n'), next.n);
         gl.uniform1f(u('u_tail_share'), share);
-        gl.uniform1f(u('u_peak_b2'), share > 0 && lv.b2 ? lv.b2 : 0);
-        gl.uniform1f(u('u_tail_m'), share > 0 && lv.tail_m ? lv.tail_m : 0);
         const both = new Float32Array(8 * lv.count);
         both.set(lv.taps);
         both.set(lv.info, 4 * lv.count);
@@ -445,12 +444,11 @@ class Renderer {
             const samples = Math.min(16384, 32 * 2 ** (lv.virtual_level - 1));
             // The coarse tail (prefilter_options::coarse_tail): from the next level when its face is >= 16.
             const rn = convolved(k + 1) && chain.levels[k + 1].size >= 16 ? spec.levels[k + 1].roughness : -1;
-            const taps = fastTaps(shapes, lv.roughness, samples, weight, true, packed, rn);
-            plan.push({ k, n: chain.levels[k].size, ...taps,
-                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight, undefined, rn, taps.tail_c) });
+            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed, rn),
+                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight) });
         });
         plan.sort((a, b) => b.k - a.k); // coarse to fine: a coarse tail reads the finished next level
-        const done = new Map(); // level k -> its faces read back (RGBA floats), for the level before it
+        const done = new Map(); // level k -> its faces before their peaks (RGBA floats), for the level before it
         for (const lv of plan)
             lv.next = () => {
                 const m = chain.levels[lv.k + 1].size, faces = done.get(lv.k + 1);
@@ -460,14 +458,29 @@ class Renderer {
         const srcTex = packedTexture(gl, packed.data, 4096);
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-        const made = prefilterPasses(gl, this.prefilterProgram, this.vao, plan, (lv, f) =>
-            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k), (lv, f) => {
-            if (!plan.some((p) => p.k === lv.k - 1 && p.tail_share > 0)) return;
+        const needed = (lv) => plan.some((p) => p.k === lv.k - 1 && p.tail_share > 0);
+        let beforeTex = null; // the second output (the texels before their peaks) of a level that is read back
+        const made = prefilterPasses(gl, this.prefilterProgram, this.vao, plan, (lv, f) => {
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k);
+            if (f === 0 && needed(lv)) {
+                gl.activeTexture(gl.TEXTURE5); // on no sampler's unit
+                if (beforeTex) gl.deleteTexture(beforeTex);
+                beforeTex = gl.createTexture();
+                gl.bindTexture(gl.TEXTURE_2D, beforeTex);
+                gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
+                gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, beforeTex, 0);
+            }
+            gl.drawBuffers(needed(lv) ? [gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1] : [gl.COLOR_ATTACHMENT0, gl.NONE]);
+        }, (lv, f) => {
+            if (!needed(lv)) return;
             const px = new Float32Array(4 * lv.n * lv.n);
+            gl.readBuffer(gl.COLOR_ATTACHMENT1);
             gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
+            gl.readBuffer(gl.COLOR_ATTACHMENT0);
             if (!done.has(lv.k)) done.set(lv.k, []);
             done.get(lv.k)[f] = px;
         });
+        if (beforeTex) gl.deleteTexture(beforeTex);
         gl.finish();
         const t2 = performance.now();
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
@@ -740,8 +753,7 @@ async function runPrefilterTest() {
         return { max_abs: d, factor: t.factor, expected_factor: lv.factor, tail_share: t.tail_share,
                  expected_tail_share: lv.tail_share || 0 };
     });
-    const jsPeaks = fx.levels.map((lv, i) =>
-        makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight, undefined, nextR(lv), jsTaps[i].tail_c));
+    const jsPeaks = fx.levels.map((lv) => makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight));
     const peaksDiff = fx.levels.map((lv, i) => {
         const p = jsPeaks[i];
         if (p.peak_count !== lv.peak_count || p.g1 !== lv.g1) return { count: p.peak_count, expected: lv.peak_count };
@@ -751,50 +763,59 @@ async function runPrefilterTest() {
             if (j % 6 < 3) dir = Math.max(dir, d);
             else energy = Math.max(energy, d / Math.max(1e-30, Math.abs(lv.peaks[j])));
         }
-        return { count: p.peak_count, dir_max_abs: dir, energy_max_rel: energy, a2: p.a2, expected_a2: lv.a2,
-                 tail_m: p.tail_m, expected_tail_m: lv.tail_m || 0 };
+        return { count: p.peak_count, dir_max_abs: dir, energy_max_rel: energy, a2: p.a2, expected_a2: lv.a2 };
     });
-    // Each level into an RGBA32F target, read back face by face (rows from y = 0: the chain's order).
-    const render = (levels, finished = () => {}) => {
-        const out = [];
+    // Each level into two RGBA32F targets (the texels, and the texels before their peaks), read back
+    // face by face (rows from y = 0: the chain's order). The levels go coarse to fine per weight, and
+    // a coarse tail reads the GPU's own next level before its peaks (read back, packed by packSource).
+    const render = (levels) => {
+        const out = [], before = new Map();
+        const ordered = levels.slice().sort((a, b) => (a.weight === b.weight ? b.level - a.level : a.weight < b.weight ? -1 : 1));
+        for (const lv of ordered)
+            lv.next = () => {
+                const nx = before.get(`${lv.weight}/${lv.level + 1}`);
+                const m = nx.n, at = (f, x, y) => { const k = 3 * ((f * m + y) * m + x); return [nx.rgb[k], nx.rgb[k + 1], nx.rgb[k + 2]]; };
+                return { n: m, data: packSource(m, at, null, 1).data };
+            };
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-        let tex = null, rgb = null;
-        prefilterPasses(gl, program, vao, levels, (lv, f) => {
-            if (f !== 0) return;
-            gl.activeTexture(gl.TEXTURE2); // the render target binds here, on no sampler's unit
-            tex = gl.createTexture();
+        gl.drawBuffers([gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1]);
+        let rgb = null, base = null;
+        const target = (n, attachment) => {
+            const tex = gl.createTexture();
             gl.bindTexture(gl.TEXTURE_2D, tex);
-            gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
-            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+            gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, n, n, 0, gl.RGBA, gl.FLOAT, null);
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, attachment, gl.TEXTURE_2D, tex, 0);
+        };
+        const readBack = (n, attachment, into) => {
+            const px = new Float32Array(4 * n * n);
+            gl.readBuffer(attachment);
+            gl.readPixels(0, 0, n, n, gl.RGBA, gl.FLOAT, px);
+            for (let k = 0; k < n * n; ++k) into.push(px[4 * k], px[4 * k + 1], px[4 * k + 2]);
+        };
+        prefilterPasses(gl, program, vao, ordered, (lv, f) => {
+            if (f !== 0) return;
+            gl.activeTexture(gl.TEXTURE2); // the render targets bind here, on no sampler's unit
+            target(lv.n, gl.COLOR_ATTACHMENT0);
+            target(lv.n, gl.COLOR_ATTACHMENT1);
             rgb = [];
+            base = [];
         }, (lv, f) => {
-            const px = new Float32Array(4 * lv.n * lv.n);
-            gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
-            for (let k = 0; k < lv.n * lv.n; ++k) rgb.push(px[4 * k], px[4 * k + 1], px[4 * k + 2]);
+            readBack(lv.n, gl.COLOR_ATTACHMENT0, rgb);
+            readBack(lv.n, gl.COLOR_ATTACHMENT1, base);
             if (f === 5) {
                 out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
-                finished(out[out.length - 1]);
+                before.set(`${lv.weight}/${lv.level}`, { n: lv.n, rgb: base });
             }
         });
+        gl.readBuffer(gl.COLOR_ATTACHMENT0);
         return out;
     };
-    // The C++ inputs, the coarse tail's next level included (the C++ chain's, packed as it reads it).
     packedTexture(gl, Float32Array.from(fx.packed), fx.width);
-    const levels = render(fx.levels.map((lv) => ({ ...lv, next: () => ({ n: lv.next_n, data: Float32Array.from(lv.next_packed) }) })));
-    // The whole live path: the viewer's packing and taps through the same shader, the levels coarse
-    // to fine, each coarse tail reading the GPU's own next level (read back and packed by packSource).
-    const mine = new Map();
-    const ordered = fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] }))
-        .sort((a, b) => (a.weight === b.weight ? b.level - a.level : a.weight < b.weight ? -1 : 1));
-    for (const lv of ordered)
-        lv.next = () => {
-            const nx = mine.get(`${lv.weight}/${lv.level + 1}`);
-            const m = nx.n, at = (f, x, y) => { const k = 3 * ((f * m + y) * m + x); return [nx.rgb[k], nx.rgb[k + 1], nx.rgb[k + 2]]; };
-            return { n: m, data: packSource(m, at, null, 1).data };
-        };
+    const levels = render(fx.levels.map((lv) => ({ ...lv })));
+    // The whole live path: the viewer's packing and taps through the same shader.
     packedTexture(gl, js.data, fx.width);
-    const jsLevels = render(ordered, (r) => mine.set(`${r.weight}/${r.level}`, r));
+    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] })));
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
                  packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff,
                  source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });

@@ -472,25 +472,25 @@ public:
                                                                           opt_.lod_bias, opt_.weight, next_roughness);
         table.trilinear = lp.trilinear;
         lv.taps = make_taps(table, int(packed_.levels.size()));
-        lv.peaks = level_peaks(lp, next_roughness);
+        lv.peaks = level_peaks(lp);
         if (next_roughness >= 0.0) lv.tail_share = float(fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).share);
         return lv;
     }
-    /// The merged peaks of a plan level (empty without a split), with the coarse tail's kernel
-    /// removed when next_roughness >= 0.
-    [[nodiscard]] peak_level level_peaks(const prefilter_level& lp, double next_roughness = -1.0) const {
+    /// The merged peaks of a plan level (empty without a split), with the level's whole kernel.
+    [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
         if (peaks_.empty()) return {};
-        double c = 0.0;
-        if constexpr (std::is_same_v<Lobe, ggx_lobe>)
-            if (next_roughness >= 0.0) c = fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).c;
         return make_peak_level(peaks_, n0_, table_source_levels_, lp.roughness, opt_.weight, opt_.peaks.footprint,
-                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut, next_roughness, c);
+                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut);
     }
-    /// Row `row` (face n + y) of an n x n level; `next` is the next level (lv.tail_share > 0).
-    void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr) const {
+    /// Row `row` (face n + y) of an n x n level: the tap set, then the coarse tail from `next` (the
+    /// next level without its peaks; lv.tail_share > 0), then the peaks. base_out (when not null)
+    /// receives the row before its peaks: this level as the coarse tail of the level before it reads it.
+    void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,
+             vec3<float>* base_out = nullptr) const {
         convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
-        splat_peaks_row(lv.peaks, int(row) / n, int(row) % n, n, out);
         if (next && lv.tail_share > 0.f) add_coarse_tail_row(*next, lv.tail_share, int(row) / n, int(row) % n, n, out);
+        if (base_out) std::copy(out, out + n, base_out);
+        splat_peaks_row(lv.peaks, int(row) / n, int(row) % n, n, out);
     }
     [[nodiscard]] std::size_t peak_count() const noexcept { return peaks_.size(); }
 
@@ -544,12 +544,18 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0));
                 const detail::prefilter_cube_level lv = cs.level(env, lp, rn);
                 const cubemap<float>* nx = rn >= 0.0 && next ? &*next : nullptr;
+                // The level before this one reads its coarse tail from this level without its peaks
+                // (they are added to every level exactly, through its own kernel).
+                std::vector<vec3<float>> base;
+                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0)) >= 0.0)
+                    base.resize(std::size_t(6) * std::size_t(n) * std::size_t(n));
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row], nx);
+                    for (std::size_t row = b; row < e; ++row)
+                        cs.row(lv, row, n, rows[row], nx, base.empty() ? nullptr : base.data() + row * std::size_t(n));
                 });
+                if (!base.empty())
+                    next = detail::prefilter_tail_cube(n, [&](int f, int x, int y) { return base[cube_texel_index(f, x, y, n)]; });
             }
-            if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0)) >= 0.0)
-                next = detail::prefilter_tail_cube(n, [&](int f, int x, int y) { return out.texel(f, x, y, int(k)); });
         }
     } else {
         for (const std::size_t k : order) {

@@ -42,12 +42,16 @@
 // for n.l the minimum is at theta = pi/2, c = (a^2 / b^2) ((1 + b^2) / (1 + a^2))^2 (a, b the two
 // alphas), so K_rest falls as a^2 b^2 / theta^6: its mass beyond theta is O(a^2 b^2 / theta^4)
 // against O(a^2 / theta^2) for K. The tap set is the spiral of K_rest (its radial CDF, the same
-// shapes) with scale 1 - share, the peak split uses K_rest in closed form (prefilter_peaks.hpp),
-// and LD_next is one bilinear read of the finished next level at the texel centre (the levels are
-// filtered coarse to fine). A level reads its tail only from a next level of face >= 16
-// (prefilter_coarse_tail_min_face): the bilinear read of coarser texels costs more than the tail
-// saves. Measured (research/fast_tap_study.cpp, docs/ibl-bake.md "Fast filter"): on two HDRIs it
-// lowers levels 1-3 of a 256^2 chain by 1.1-2x at the same samples.
+// shapes) with scale 1 - share, and LD_next is one bilinear read of the finished next level at the
+// texel centre (the levels are filtered coarse to fine). With the peak split (prefilter_peaks.hpp)
+// L = base + peaks: the tail reads the next level before its peaks were added (its base part) and
+// every level adds the peaks through its own whole kernel in closed form, so a sun is never
+// interpolated from a coarser level (reading the next level with its sun smoothed the kink of its
+// n.l cut-off: the sky's level 3 of a 256^2 chain went 0.0038 -> 0.016). A level reads its tail
+// only from a next level of face >= 16 (prefilter_coarse_tail_min_face): the bilinear read of
+// coarser texels costs more than the tail saves. Measured (research/fast_tap_study.cpp,
+// docs/ibl-bake.md "Fast filter"): on two HDRIs it lowers levels 1-3 of a 256^2 chain by 1.1-2x at
+// the same samples.
 //
 // Cost: N samples per texel (one bilinear tap each from the nearest level, the default plan's
 // reads; two with trilinear reads), the default schedule fast_default_samples * 2^(l - 1) against

@@ -334,10 +334,6 @@ struct peak_level {
     std::vector<float> px, py, pz, er, eg, eb;
     std::vector<float> lum; ///< luminance of (er, eg, eb): the row cut's bound
     float a2 = 0.f, half_a2 = 0.f;
-    /// The coarse tail (prefilter_options::coarse_tail): the kernel is K - c K_next, K_next the
-    /// next level's (alpha_next^2 = b2), i.e. w / q^2 - tail_m w_next / q_next^2 with tail_m =
-    /// c b2 / a2; tail_m = 0 without it.
-    float tail_m = 0.f, b2 = 0.f, half_b2 = 0.f;
     float floor = 0.f; ///< the cut's floor: 1e-2 times the source's mean luminance
     float cut = 0.f;   ///< peak_split_options::cut
     bool g1 = false;
@@ -345,11 +341,10 @@ struct peak_level {
 };
 
 /// Builds a level's peak list: the split's peaks merged at peak_merge_mip, with the kernel of the
-/// GGX lobe at roughness r and the LD weight; with next_roughness >= 0 and tail_c > 0 the kernel
-/// less tail_c times that of next_roughness (the coarse tail, bake/prefilter_fast.hpp).
+/// GGX lobe at roughness r and the LD weight.
 inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
                                   ld_weight weight, double footprint, double max_angle, double mean_luminance,
-                                  double cut = 1e-3, double next_roughness = -1.0, double tail_c = 0.0) {
+                                  double cut = 1e-3) {
     peak_level pl;
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
@@ -369,12 +364,6 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
     pl.a2 = float(a2);
     pl.half_a2 = float(0.5 * a2);
     pl.g1 = weight == ld_weight::g1;
-    if (std::isfinite(next_roughness) && next_roughness >= 0.0 && std::isfinite(tail_c) && tail_c > 0.0) {
-        const double b = std::max(alpha_from_roughness(std::min(next_roughness, 1.0)), 1e-4), b2 = b * b;
-        pl.tail_m = float(tail_c * b2 / a2);
-        pl.b2 = float(b2);
-        pl.half_b2 = float(0.5 * b2);
-    }
     return pl;
 }
 
@@ -398,7 +387,6 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
     const float cos_half = std::min(dot(mid, e0), dot(mid, e1));
     const float sin_half = std::sqrt(std::max(0.f, 1.f - cos_half * cos_half));
     const float ha2 = pl.half_a2, a2 = pl.a2, one_minus_a2 = 1.f - pl.a2;
-    const float tm = pl.tail_m, hb2 = pl.half_b2, b2 = pl.b2, one_minus_b2 = 1.f - pl.b2;
     float darkest = luminance(out[0]);
     for (int x = 1; x < n; ++x) darkest = std::min(darkest, luminance(out[x]));
     const float cut = pl.cut * std::max(darkest, pl.floor) / float(pl.size());
@@ -426,29 +414,7 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
         for (const std::uint32_t j : live) {
             const float px = pl.px[j], py = pl.py[j], pz = pl.pz[j];
             const float er = pl.er[j], eg = pl.eg[j], eb = pl.eb[j];
-            if (tm > 0.f && pl.g1) { // the coarse tail's rest: K - c K_next, clamped at 0
-                for (int k = 0; k < W; ++k) {
-                    const float c = dx[k] * px + dy[k] * py + dz[k] * pz;
-                    const float cp = c > 0.f ? c : 0.f;
-                    const float q = 0.5f * (1.f - cp) + ha2 * (1.f + cp);
-                    const float qn = 0.5f * (1.f - cp) + hb2 * (1.f + cp);
-                    const float g = 2.f / (cp + std::sqrt(a2 + one_minus_a2 * cp * cp));
-                    const float gn = 2.f / (cp + std::sqrt(b2 + one_minus_b2 * cp * cp));
-                    const float kd = cp * (g / (q * q) - tm * gn / (qn * qn));
-                    const float kk = kd > 0.f ? kd : 0.f;
-                    ar[k] += er * kk, ag[k] += eg * kk, ab[k] += eb * kk;
-                }
-            } else if (tm > 0.f) {
-                for (int k = 0; k < W; ++k) {
-                    const float c = dx[k] * px + dy[k] * py + dz[k] * pz;
-                    const float cp = c > 0.f ? c : 0.f;
-                    const float q = 0.5f * (1.f - cp) + ha2 * (1.f + cp);
-                    const float qn = 0.5f * (1.f - cp) + hb2 * (1.f + cp);
-                    const float kd = cp * (1.f / (q * q) - tm / (qn * qn));
-                    const float kk = kd > 0.f ? kd : 0.f;
-                    ar[k] += er * kk, ag[k] += eg * kk, ab[k] += eb * kk;
-                }
-            } else if (pl.g1) {
+            if (pl.g1) {
                 for (int k = 0; k < W; ++k) {
                     const float c = dx[k] * px + dy[k] * py + dz[k] * pz;
                     const float cp = c > 0.f ? c : 0.f;

@@ -75,7 +75,7 @@ public:
         else // the tables stay; the peaks of the fast filter's split belong to the source
             for (std::size_t k = 0; k < levels_.size(); ++k)
                 if (!levels_[k].mirror) {
-                    levels_[k].conv.peaks = src_->level_peaks(plan_[k], levels_[k].tail_roughness);
+                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
                     levels_[k].taps_per_row = convolved_row_taps(levels_[k]);
                 }
         pos_ = 0;
@@ -145,6 +145,7 @@ private:
         double tail_roughness = -1.0;        ///< >= 0: reads its coarse tail from the next level
         std::uint64_t taps_per_row = 1;
         std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
+        std::vector<vec3<float>> before_peaks; ///< the texels before the peaks, when the level before reads this one
         std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
     };
 
@@ -176,6 +177,8 @@ private:
             lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
             levels_.push_back(std::move(lw));
         }
+        for (std::size_t k = 1; k < levels_.size(); ++k)
+            if (levels_[k - 1].tail_roughness >= 0.0) levels_[k].before_peaks.assign(levels_[k].texels.size(), vec3<float>(0.0f));
         order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
@@ -188,7 +191,7 @@ private:
             for (std::size_t r = begin + b; r < begin + e; ++r) {
                 vec3<float>* out = lw.texels.data() + r * std::size_t(n);
                 if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
-                else src_->row(lw.conv, r, n, out, next);
+                else src_->row(lw.conv, r, n, out, next, lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + r * std::size_t(n));
             }
         });
     }
@@ -199,7 +202,7 @@ private:
         if (level_ > 0 && levels_[level_ - 1].tail_roughness >= 0.0) {
             const level_work& lw = levels_[level_];
             levels_[level_].as_next =
-                detail::prefilter_tail_cube(lw.n, [&](int f, int x, int y) { return lw.texels[cube_texel_index(f, x, y, lw.n)]; });
+                detail::prefilter_tail_cube(lw.n, [&](int f, int x, int y) { return lw.before_peaks[cube_texel_index(f, x, y, lw.n)]; });
         }
         if (++pos_ < order_.size()) {
             level_ = order_[pos_];

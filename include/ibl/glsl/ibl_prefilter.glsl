@@ -17,10 +17,10 @@
 //         the level's a2 (alpha^2) and LD weight (g1: ld_weight::g1, else n.l). The source is then
 //         the split's base (split_cube_peaks), packed. ibl_prefilter_peaks adds them exactly.
 //   next (optional: the fast filter's coarse tail, prefilter_options::coarse_tail) RGBA32F 2-D
-//         texture: the finished next level (n_next x n_next faces) packed with its 1-texel border
-//         as detail::pack_cube packs one level; ibl_prefilter_tail adds share times its bilinear
-//         read at the texel centre, and the taps and peaks are then those of the rest kernel
-//         (make_ld_table_for / make_peak_level with the next roughness: b2 = alpha_next^2, tail_m).
+//         texture: the finished next level before its peaks (n_next x n_next faces) packed with
+//         its 1-texel border as detail::pack_cube packs one level; ibl_prefilter_tail adds share
+//         times its bilinear read at the texel centre to the taps, which are then those of the
+//         rest kernel (make_ld_table_for with the next roughness), before the peaks are added.
 // Every operation is the C++ kernel's in the same order (the frame, the branch-free face selection,
 // the bordered bilinear address and weights, the blocks of 32 taps), so the result equals the
 // C++ within float rounding (the browser test: within half-float rounding on every level).
@@ -108,10 +108,8 @@ vec3 ibl_prefilter_texel(sampler2D src, sampler2D taps, int count, float factor,
 // The C++ adds this sum to the tap set's result after it, in list order, as here; it skips the
 // peaks behind a whole face row (whose terms are 0) and, with peak_split_options::cut > 0, the
 // negligible ones: cut = 0 gives the sum here. peak_count 0: the tap set only.
-// With the coarse tail (tail_m > 0) the kernel is the rest's, cp (w / q^2 - tail_m w_next / q_next^2)
-// clamped at 0, q_next and w_next those of b2 (detail::splat_peaks_row); tail_m = 0: the kernel above.
-vec3 ibl_prefilter_peaks_rest(sampler2D peaks, int peak_count, float a2, bool g1, float b2, float tail_m, vec3 dir) {
-    float ha2 = 0.5 * a2, one_minus_a2 = 1.0 - a2, hb2 = 0.5 * b2, one_minus_b2 = 1.0 - b2;
+vec3 ibl_prefilter_peaks(sampler2D peaks, int peak_count, float a2, bool g1, vec3 dir) {
+    float ha2 = 0.5 * a2, one_minus_a2 = 1.0 - a2;
     vec3 acc = vec3(0.0);
     for (int j = 0; j < peak_count; ++j) {
         vec4 d = texelFetch(peaks, ivec2(j, 0), 0);
@@ -120,18 +118,7 @@ vec3 ibl_prefilter_peaks_rest(sampler2D peaks, int peak_count, float a2, bool g1
         float cp = c > 0.0 ? c : 0.0;
         float q = 0.5 * (1.0 - cp) + ha2 * (1.0 + cp);
         float k;
-        if (tail_m > 0.0) {
-            float qn = 0.5 * (1.0 - cp) + hb2 * (1.0 + cp);
-            float kd;
-            if (g1) {
-                float g = 2.0 / (cp + sqrt(a2 + one_minus_a2 * cp * cp));
-                float gn = 2.0 / (cp + sqrt(b2 + one_minus_b2 * cp * cp));
-                kd = cp * (g / (q * q) - tail_m * gn / (qn * qn));
-            } else {
-                kd = cp * (1.0 / (q * q) - tail_m / (qn * qn));
-            }
-            k = kd > 0.0 ? kd : 0.0;
-        } else if (g1) {
+        if (g1) {
             float g = 2.0 / (cp + sqrt(a2 + one_minus_a2 * cp * cp)); // G1 / n.l
             k = cp * g / (q * q);
         } else {
@@ -140,9 +127,6 @@ vec3 ibl_prefilter_peaks_rest(sampler2D peaks, int peak_count, float a2, bool g1
         acc += e.rgb * k;
     }
     return acc;
-}
-vec3 ibl_prefilter_peaks(sampler2D peaks, int peak_count, float a2, bool g1, vec3 dir) {
-    return ibl_prefilter_peaks_rest(peaks, peak_count, a2, g1, 0.0, 0.0, dir);
 }
 
 // The coarse tail (prefilter_options::coarse_tail, detail::add_coarse_tail_row): share times the
