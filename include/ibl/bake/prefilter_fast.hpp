@@ -174,20 +174,26 @@ template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_
 /// levels every frame does not rebuild the 4097-node quadrature per level and per call. Only the
 /// built-in GGX lobe is cached (its kernel depends on nothing else); the values are those of
 /// make_fast_radial_cdf.
-inline std::shared_ptr<const fast_radial_cdf> ggx_fast_radial_cdf(double roughness, ld_weight weight) {
+/// A process-wide memo of at most 64 values, one per call site (its lambda type), cleared when full, behind a
+/// mutex: make() runs outside the lock, so two threads may compute the same entry once each (the
+/// same value: the first stored wins).
+template <class Key, class Value, class Make> std::shared_ptr<const Value> fast_memo(const Key& key, Make&& make) {
     static std::mutex mutex;
-    static std::map<std::pair<double, int>, std::shared_ptr<const fast_radial_cdf>> cache;
-    const std::pair<double, int> key(roughness, int(weight));
+    static std::map<Key, std::shared_ptr<const Value>> cache;
     {
         const std::lock_guard<std::mutex> lock(mutex);
         const auto it = cache.find(key);
         if (it != cache.end()) return it->second;
     }
-    auto c = std::make_shared<const fast_radial_cdf>(make_fast_radial_cdf<ggx_lobe>(roughness, weight));
+    auto v = std::make_shared<const Value>(make());
     const std::lock_guard<std::mutex> lock(mutex);
     if (cache.size() >= 64) cache.clear();
-    cache.emplace(key, c);
-    return c;
+    return cache.emplace(key, v).first->second;
+}
+inline std::shared_ptr<const fast_radial_cdf> ggx_fast_radial_cdf(double roughness, ld_weight weight) {
+    return fast_memo<std::pair<double, int>, fast_radial_cdf>(std::pair<double, int>(roughness, int(weight)), [&] {
+        return make_fast_radial_cdf<ggx_lobe>(roughness, weight);
+    });
 }
 
 /// The coarse tail of a level (header: "Coarse tail"): LD = (1 - share) [the tap set of
@@ -226,19 +232,10 @@ template <class Lobe> fast_rest_kernel make_fast_rest_kernel(double roughness, d
 /// make_fast_rest_kernel of the GGX lobe, memoised per (roughness, next roughness, weight) as
 /// ggx_fast_radial_cdf.
 inline std::shared_ptr<const fast_rest_kernel> ggx_fast_rest_kernel(double roughness, double next_roughness, ld_weight weight) {
-    static std::mutex mutex;
-    static std::map<std::tuple<double, double, int>, std::shared_ptr<const fast_rest_kernel>> cache;
-    const std::tuple<double, double, int> key(roughness, next_roughness, int(weight));
-    {
-        const std::lock_guard<std::mutex> lock(mutex);
-        const auto it = cache.find(key);
-        if (it != cache.end()) return it->second;
-    }
-    auto c = std::make_shared<const fast_rest_kernel>(make_fast_rest_kernel<ggx_lobe>(roughness, next_roughness, weight));
-    const std::lock_guard<std::mutex> lock(mutex);
-    if (cache.size() >= 64) cache.clear();
-    cache.emplace(key, c);
-    return c;
+    using key = std::tuple<double, double, int>;
+    return fast_memo<key, fast_rest_kernel>(key(roughness, next_roughness, int(weight)), [&] {
+        return make_fast_rest_kernel<ggx_lobe>(roughness, next_roughness, weight);
+    });
 }
 /// The coarse tail of lobe L between two roughnesses (memoised for GGX).
 template <class Lobe> fast_coarse_tail fast_tail_of(double roughness, double next_roughness, ld_weight weight) {
