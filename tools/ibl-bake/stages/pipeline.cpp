@@ -115,12 +115,12 @@ std::vector<table_row> all_rows(const std::vector<std::unique_ptr<stage>>& stage
 const char* checks_accuracy(check_mode mode) {
     if (mode == check_mode::none) return "no reference checks ran (--checks none): the products are written unchecked";
     if (mode == check_mode::full) return "the full references of the quality (docs/ibl-bake.md, quality table)";
-    return "fast: a texel grid 3 smaller per side (at least 3), a quarter of the reference LD samples, an eighth of the "
-           "split-sum reference samples (reference_rel_std_error gives that noise), the lookup check at the roughness midway "
-           "between levels with the chosen lookup only and texel-sum references of 4 texels per alpha, the irradiance brute "
-           "force over a level of face <= 64, the two-tap table's midpoint check without direct fits. The specular levels' "
-           "rel_rmse then includes the smaller reference's noise (an upper bound: up to 3x the full figure on a sharp "
-           "probe's rough levels); the other figures agree with full's within their reference's noise or 10-20% "
+    return "fast: a texel grid 3 smaller per side (at least 3), a quarter of the built-in sky's reference LD samples (maps "
+           "and cubes are checked against the exact texel sum in both modes), an eighth of the split-sum reference samples "
+           "(reference_rel_std_error gives that noise), the lookup check at the roughness midway between levels with the "
+           "chosen lookup only and texel-sum references of 4 texels per alpha, the irradiance brute force over a level of "
+           "face <= 64, the two-tap table's midpoint check without direct fits. The specular levels' rel_rmse is then "
+           "measured on fewer texels; the other figures agree with full's within their reference's noise or 10-20% "
            "(docs/ibl-bake.md, \"Checks\")";
 }
 

@@ -83,8 +83,8 @@ double mean_luminance(const ibl::cubemap<float>& cube) {
 }
 
 /// Every level of `chain` against its reference (level 0: the 16^2 sub-sampled texel mean of the
-/// capture; rougher levels: ibl::reference_ld_sky or ibl::reference_ld on the input, the chain's
-/// LD weight), at the full bake's check texels with --checks fast's grid and samples.
+/// capture; rougher levels: ibl::reference_ld_sky, or ibl::ld_texel_sum over the capture's cube,
+/// the chain's LD weight), at the full bake's check texels with --checks fast's grid and samples.
 std::vector<probe_level_check> check_chain(const source_env& src, const ibl::cubemap<float>& source, const ibl::cubemap<float>& chain,
                                            const ibl::specular_plan& sp, ibl::ld_weight weight, const quality_settings& qc,
                                            double floor, pool_executor& ex) {
@@ -98,7 +98,7 @@ std::vector<probe_level_check> check_chain(const source_env& src, const ibl::cub
         lc.roughness = lp.roughness;
         lc.samples = lp.samples;
         const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qc.ref_grid, light);
-        const std::vector<dvec3> ref = chain_check_references(src, texels, lc.size, lp.level == 0, lc.roughness, qc, weight, ex);
+        const std::vector<dvec3> ref = chain_check_references(src, source, texels, lc.size, lp.level == 0, lc.roughness, qc, weight, ex);
         ibl::error_accumulator acc(floor);
         for (std::size_t i = 0; i < texels.size(); ++i)
             acc.add(dvec3(chain.texel(texels[i][0], texels[i][1], texels[i][2], k)), ref[i]);

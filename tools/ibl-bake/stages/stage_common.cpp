@@ -415,10 +415,16 @@ void json_triples(json_writer& j, const sh5& c, int count) {
     j.end_array();
 }
 
-std::vector<dvec3> chain_check_references(const source_env& src, const std::vector<std::array<int, 3>>& texels, int n,
-                                          bool mirror, double roughness, const quality_settings& qs, ibl::ld_weight w,
-                                          pool_executor& ex) {
+std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cubemap<float>& cube,
+                                          const std::vector<std::array<int, 3>>& texels, int n, bool mirror, double roughness,
+                                          const quality_settings& qs, ibl::ld_weight w, pool_executor& ex) {
     std::vector<dvec3> ref(texels.size());
+    if (!mirror && !src.analytic) { // the exact LD of the source cube: a deterministic texel sum
+        std::vector<dvec3> dirs(texels.size());
+        for (std::size_t i = 0; i < texels.size(); ++i)
+            dirs[i] = ibl::cube_texel_direction<double>(texels[i][0], texels[i][1], texels[i][2], n);
+        return ibl::ld_texel_sum(cube, ibl::ld_texel_sum_level(cube, roughness), std::span<const dvec3>(dirs), roughness, w, ex);
+    }
     src.visit([&](const auto& env) {
         ex(texels.size(), [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {

@@ -175,7 +175,7 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
     lc.trilinear = lp.trilinear && method_ != prefilter_choice::fast; // the fast filter reads the nearest level
     const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qs_.ref_grid, ctx.light);
     const std::vector<dvec3> ref =
-        chain_check_references(ctx.src, texels, lc.size, lp.level == 0, lc.roughness, qs_, weight_, ctx.ex);
+        chain_check_references(ctx.src, ctx.whole_source(), texels, lc.size, lp.level == 0, lc.roughness, qs_, weight_, ctx.ex);
     // Relative errors use a floor of 1e-3 x the mean radiance (dark texels do not dominate). With an
     // extracted sun the product is what the runtime gets: the level plus the sun's LD term (level 0:
     // the texel with the removed excess added back, i.e. the source before extraction).
@@ -313,7 +313,8 @@ void specular_stage::report(json_writer& j) const {
     j.key("reference").value(std::string(analytic_ ? "level 0: texel mean (16x16 sub-samples); levels >= 1: ibl::reference_ld_sky "
                                                      "(sky by GGX IS + sun cap quadrature)"
                                                    : "level 0: texel mean (16x16 sub-samples) of the input; levels >= 1: "
-                                                     "ibl::reference_ld on the input lat-long map (GGX IS, double)") +
+                                                     "ibl::ld_texel_sum, the exact LD of the source cube (a texel sum in "
+                                                     "double at ibl::ld_texel_sum_level; no sampling noise)") +
                              ", with the chain's LD weight");
     j.key("texels").value("per level: a grid per face plus the 3x3 block around the brightest direction");
     j.key("relative_error_floor").value(floor_);

@@ -185,10 +185,14 @@ dvec3 brightest_direction(const ibl::cubemap<float>& cube, int level);
 inline constexpr int level0_ref_k = 16;
 /// The references a chain level is checked against at `texels` (face, x, y) of its n x n faces:
 /// level 0 (mirror = true) the level0_ref_k^2 sub-sampled texel mean of the source; rougher
-/// levels ibl::reference_ld_sky (analytic sky) or ibl::reference_ld (maps) at `roughness` with
-/// the quality settings' samples and the chain's LD weight. One definition for the bake's check
-/// and the probe set's.
-std::vector<dvec3> chain_check_references(const source_env& src, const std::vector<std::array<int, 3>>& texels, int n,
+/// levels ibl::reference_ld_sky (analytic sky: GGX IS of the sky, quadrature of the sun's cap)
+/// or, for maps and cubes, ibl::ld_texel_sum over `cube` (the source cube the chain is filtered
+/// from, before any sun extraction) at ibl::ld_texel_sum_level: the exact LD of that cube, no
+/// sampling noise, and no Hammersley points shared with filtered importance sampling (which
+/// reference_ld at the chain's own sample count would share, hiding FIS's error). The chain's LD
+/// weight throughout. One definition for the bake's check and the probe set's.
+std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cubemap<float>& cube,
+                                          const std::vector<std::array<int, 3>>& texels, int n,
                                           bool mirror, double roughness, const quality_settings& qs, ibl::ld_weight w,
                                           pool_executor& ex);
 
