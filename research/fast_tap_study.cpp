@@ -5,12 +5,13 @@
 //                                                                         studio of tests/data, 400)
 //   build/release/research/fast_tap_study --quick                        (ctest: one file, 32 texels)
 //
-// What it measures. ibl-bake's check compares a chain with reference_ld at 1024 (--checks fast,
-// the default) or 4096 (--checks full) GGX samples per texel; on a real HDRI that reference is
-// itself noisy, and at the default filter's accuracy the noise dominates the figure. Here the
-// reference is reference_ld with 2^15 samples (lat-long source, as the tool) at N random texels
-// per level of a 256^2, 6-level chain (r = l / 5, n.l weight), and the table lists:
-//   * the check's own references (1024 and 4096 samples) against it: the floor of the tool's figures;
+// What it measures. The reference is ibl::ld_texel_sum over level 0 of the 256^2 source cube (the
+// exact LD of the cube the chains are filtered from: no sampling noise) at N random texels per
+// level of a 256^2, 6-level chain (r = l / 5, n.l weight), and the table lists:
+//   * the references ibl-bake's check used before (reference_ld at 2048 and 8192 GGX samples on
+//     the lat-long map: --checks fast and full at the default quality): on a real HDRI they are as noisy as the filters are wrong, and they draw
+//     filtered importance sampling's own Hammersley points (at equal counts FIS shares their error);
+//   * ld_texel_sum at ld_texel_sum_level (the coarser level the check sums now) against level 0;
 //   * filtered importance sampling with the default schedule (512 x 2^(l-1), trilinear, bias 0.5);
 //   * the fast filter's tap set (bake/prefilter_fast.hpp, the fitted shapes, nearest reads), no peak split;
 //   * candidates for its successor:
@@ -152,7 +153,8 @@ struct design {
     double tail = 1.0, bias = 0.0;
     std::uint32_t n0 = 0;
     double max_share = 1.0; ///< coarse tail: the largest share of the kernel read from the next level
-    bool library = false;   ///< ibl::prefilter itself (method fast, no peak split, coarse_tail = reuse)
+    bool library = false;   ///< ibl::prefilter itself (method fast, coarse_tail = reuse)
+    bool peaks = false;     ///< library: with the peak split (the tool's default)
 };
 
 /// Per level of the chain, the rel RMSE of luminance at the reference texels and the taps.
@@ -178,7 +180,7 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
         for (int l = 1; l < chain_levels; ++l) o.samples_per_level[std::size_t(l)] = doubling(d.n0, l);
         o.samples = d.n0;
         o.weight = w;
-        o.peaks.enabled = false;
+        o.peaks.enabled = d.peaks;
         o.coarse_tail = d.reuse;
         const ibl::specular_chain ch = ibl::prefilter(cube, o, ex);
         for (int l = 1; l < chain_levels; ++l) {
@@ -266,6 +268,8 @@ int main(int argc, char** argv) {
                            }});
         if (!quick) {
             designs.push_back({"ibl::prefilter fast, coarse tail (the default), " + std::to_string(n0), nullptr, true, 0.0, 0.0, n0, 1.0, true});
+            designs.push_back({"ibl::prefilter fast, coarse tail and peak split (the tool's default), " + std::to_string(n0), nullptr, true,
+                               0.0, 0.0, n0, 1.0, true, true});
         }
     }
     for (std::uint32_t n0 : {16u, 32u, 64u, 128u}) {
@@ -292,25 +296,34 @@ int main(int argc, char** argv) {
         const int k = std::max(2, int(std::ceil(double(img.width) / (4.0 * base_size))));
         const ibl::cubemap<float> cube = ibl::bake_cubemap<float>(map, base_size, k, ex, 0);
         std::vector<std::vector<texel_ref>> refs(chain_levels);
-        std::vector<std::array<double, 2>> floor(chain_levels);
+        // Per level: the old check's references (reference_ld at 2048 and 8192 samples on the
+        // lat-long map) and ld_texel_sum at ld_texel_sum_level against the exact texel sum at level 0.
+        std::vector<std::array<double, 3>> floor(chain_levels);
+        std::vector<int> sum_level(chain_levels, 0);
         for (int l = 1; l < chain_levels; ++l) {
             const int n = base_size >> l;
             const double r = level_r(l);
             auto& rl = refs[std::size_t(l)];
             rl.resize(std::size_t(texels));
-            std::vector<std::array<dvec3, 2>> check(rl.size());
+            std::vector<dvec3> dirs(rl.size());
+            for (std::size_t i = 0; i < rl.size(); ++i) {
+                texel_ref& t = rl[i];
+                t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
+                t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
+                t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
+                dirs[i] = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
+            }
+            const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), r, w, ex);
+            sum_level[std::size_t(l)] = ibl::ld_texel_sum_level(cube, r);
+            const std::vector<dvec3> coarse = ibl::ld_texel_sum(cube, sum_level[std::size_t(l)], std::span<const dvec3>(dirs), r, w, ex);
+            std::vector<std::array<dvec3, 3>> check(rl.size());
             ex(rl.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i) {
-                    texel_ref& t = rl[i];
-                    t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
-                    t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
-                    t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
-                    const dvec3 dir = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
-                    t.ref = ibl::reference_ld(map, dir, r, quick ? 1u << 12 : 1u << 15, w);
-                    check[i] = {ibl::reference_ld(map, dir, r, 1024, w), ibl::reference_ld(map, dir, r, 4096, w)};
+                    rl[i].ref = exact[i];
+                    check[i] = {ibl::reference_ld(map, dirs[i], r, 2048, w), ibl::reference_ld(map, dirs[i], r, 8192, w), coarse[i]};
                 }
             });
-            for (int q = 0; q < 2; ++q) {
+            for (int q = 0; q < 3; ++q) {
                 double s = 0;
                 for (std::size_t i = 0; i < rl.size(); ++i) {
                     const double a = lum(check[i][std::size_t(q)]), b = lum(rl[i].ref);
@@ -319,13 +332,18 @@ int main(int argc, char** argv) {
                 floor[std::size_t(l)][std::size_t(q)] = std::sqrt(s / double(rl.size()));
             }
         }
-        std::printf("\n%s: 256^2, 6 levels (r = l/5), n.l weight, %d texels per level, reference %s GGX samples on the lat-long map\n\n",
-                    file.substr(file.find_last_of('/') + 1).c_str(), texels, quick ? "2^12" : "2^15");
+        std::printf("\n%s: 256^2, 6 levels (r = l/5), n.l weight, %d texels per level, reference: ibl::ld_texel_sum over "
+                    "level 0 of the 256^2 source cube (exact)\n\n",
+                    file.substr(file.find_last_of('/') + 1).c_str(), texels);
         std::printf("| tap set (samples at level 1, doubling) | taps per chain | levels 1-5 rel RMSE |\n|---|---|---|\n");
-        std::printf("| the check's own reference, 1024 samples (--checks fast) | - |");
+        std::printf("| reference_ld on the lat-long map, 2048 samples (the old --checks fast) | - |");
         for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", floor[std::size_t(l)][0]);
-        std::printf(" |\n| the check's own reference, 4096 samples (default checks) | - |");
+        std::printf(" |\n| reference_ld on the lat-long map, 8192 samples (the old --checks full) | - |");
         for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", floor[std::size_t(l)][1]);
+        std::printf(" |\n| ld_texel_sum at ld_texel_sum_level (levels");
+        for (int l = 1; l < chain_levels; ++l) std::printf(" %d", sum_level[std::size_t(l)]);
+        std::printf("; the check's reference) | - |");
+        for (int l = 1; l < chain_levels; ++l) std::printf(" %.3g", floor[std::size_t(l)][2]);
         std::printf(" |\n");
         std::vector<chain_result> results;
         for (const design& d : designs) {
@@ -342,7 +360,7 @@ int main(int argc, char** argv) {
         for (std::size_t i = 0; i < designs.size(); ++i)
             for (int l = 1; l < chain_levels; ++l) bad += std::isfinite(results[i].err[std::size_t(l)]) ? 0 : 1;
         for (std::size_t i = 1; i < designs.size(); ++i)
-            if (designs[i].reuse)
+            if (designs[i].reuse && !designs[i - 1].reuse)
                 for (int l = 1; l <= 2; ++l)
                     if (!(results[i].err[std::size_t(l)] < results[i - 1].err[std::size_t(l)])) {
                         std::printf("coarse tail not below the spiral at level %d: %g >= %g\n", l, results[i].err[std::size_t(l)],

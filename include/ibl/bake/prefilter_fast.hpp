@@ -20,16 +20,17 @@
 // The CDF is tabulated on 4097 geometric radii (trapezoid rule in double).
 //
 // The shape (tail, lod_bias) per LD weight, roughness and N is fitted offline
-// (research/fast_filter_fit.cpp, which writes bake/prefilter_fast_tables.hpp) on a point light:
-// a 256^2 source that is one bright texel (at a face centre, on an edge, at a corner) on a
-// uniform background whose radiance is the texel's exact filtered peak / c (c = 10, 100, 1000);
-// the objective is the RMS over the hemisphere about the texel of the relative error of the
-// filtered result, (F - E) / (B + E) with F the filter's response and E the exact one (the kernel
-// integrated over the texel), i.e. the relative RMSE a check reports, on a light in a darker
-// surround. fast_shape() picks the row of the nearest tabulated roughness and the largest
-// tabulated N within the level's samples; the table is then built with the level's samples.
-// Each row records filtered importance sampling's error at the same N: the fitted shapes are
-// below it at 239 of the 240 rows (within 1.2% at the other: g1, r = 0.7, N = 8).
+// (research/fast_filter_fit.cpp, which writes bake/prefilter_fast_tables.hpp) on natural
+// illumination: synthetic environments with the statistics of real illumination maps (Dror,
+// Willsky & Adelson 2004: log-luminance of about 1 / f^2 power spectrum, a bright sky over a
+// darker ground, compact lights), the objective being the relative RMSE of the filtered luminance
+// against the exact LD of each source (ibl::ld_texel_sum) at random texels, read from the nearest
+// level as the default plan reads. fast_shape() picks the row of the nearest tabulated roughness
+// and the largest tabulated N within the level's samples; the table is then built with the level's
+// samples. Each row records filtered importance sampling's error at the same N (twice the taps:
+// trilinear reads). A first fit on a point light (one bright texel on a darker surround;
+// fast_filter_fit --objective point) chose coarser reads, which real HDRIs punish (docs/ibl-bake.md,
+// "Fast filter").
 //
 // Coarse tail (prefilter_options::coarse_tail, on by default). The GGX LD kernel's tail is heavy
 // (K ~ alpha^2 / theta^4 for theta >> alpha: at r = 0.2 a sixth of its mass lies beyond 0.2 rad),
