@@ -4,11 +4,12 @@
 #                               Ninja, GLM, stb, OpenEXR, astc-encoder, Zstandard)
 #   bash scripts/deps.sh        everything the tests, benchmarks and tools need (the test command):
 #                               also clang, doctest, Google Benchmark, matplotlib, glslang, chromium,
-#                               pybind11, the Python headers, pytest and NumPy (the Python module)
+#                               pybind11, the Python headers, pytest and NumPy (the Python module),
+#                               xsimd (the benchmarks' hand-written SIMD comparison, BM_convolve_xsimd)
 set -euo pipefail
 bake=(cmake ninja-build g++ libglm-dev libstb-dev libopenexr-dev libastcenc-dev libzstd-dev)
 all=("${bake[@]}" clang libclang-rt-14-dev doctest-dev libbenchmark-dev python3-matplotlib glslang-tools chromium
-     pybind11-dev python3-dev python3-pytest python3-numpy)
+     pybind11-dev python3-dev python3-pytest python3-numpy libxsimd-dev)
 case "${1:-all}" in
     bake) pkgs=("${bake[@]}") ;;
     all) pkgs=("${all[@]}") ;;
