@@ -40,6 +40,33 @@ const sky_fixture& sky256() {
     return f;
 }
 
+// The exact LD reference of ibl-bake's specular check: ld_texel_sum of 64 directions over the 256^2
+// sky + sun cube. args: roughness x 10, coarse (1: at ld_texel_sum_level, 0: level 0). Counters:
+// ns per kernel term (one thread), and the largest relative difference of the coarse level's sum
+// from level 0's (0 for level 0).
+void BM_ld_texel_sum(benchmark::State& state) {
+    const sky_fixture& fx = sky256();
+    const double r = double(state.range(0)) / 10.0;
+    const int level = state.range(1) ? ibl::ld_texel_sum_level(fx.cube, r) : 0;
+    std::vector<dv> dirs(fx.normals.begin(), fx.normals.begin() + 64 * 97);
+    std::vector<dv> d64;
+    for (std::size_t i = 0; i < dirs.size(); i += 97) d64.push_back(dirs[i]);
+    std::vector<dv> out;
+    for (auto _ : state) {
+        out = ibl::ld_texel_sum(fx.cube, level, std::span<const dv>(d64), r);
+        benchmark::DoNotOptimize(out);
+    }
+    const std::vector<dv> l0 = ibl::ld_texel_sum(fx.cube, 0, std::span<const dv>(d64), r);
+    double mx = 0.0;
+    for (std::size_t i = 0; i < d64.size(); ++i) mx = std::max(mx, std::fabs(out[i].y - l0[i].y) / l0[i].y);
+    const double terms = double(d64.size()) * 6.0 * ibl::sqr(double(fx.cube.size(level)));
+    state.counters["ns_per_term"] = benchmark::Counter(terms * double(state.iterations()) * 1e-9,
+                                                       benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
+    state.counters["level"] = level;
+    state.counters["max_rel_vs_level0"] = mx;
+}
+BENCHMARK(BM_ld_texel_sum)->ArgNames({"r10", "coarse"})->ArgsProduct({{2, 6}, {0, 1}})->Unit(benchmark::kMillisecond);
+
 // args: block-grid bound max_face; output 32^2 per face; source 256 (sky + sun)
 void BM_irradiance_texel_moments(benchmark::State& state) {
     const sky_fixture& fx = sky256();

@@ -39,7 +39,7 @@
 // and the lod bias on a grid of 7 (-1 .. 1), then a local refinement of both about the best point.
 // Roughness 0.05 .. 1 in steps of 0.05; N = 8 .. 2048 (powers of two); both LD weights. Each row
 // also records filtered importance sampling's error with the same N (bias 0.5, Hammersley,
-// trilinear). 360 fits take about 12 minutes on 2 cores (release build).
+// trilinear). 360 fits take about 17 minutes on 2 cores (release build; 19 min with another build running).
 
 #include <algorithm>
 #include <array>
@@ -238,12 +238,12 @@ struct evaluator {
 //   [3, 30] x the mean; brighter compact lights are the peak split's, bake/prefilter_peaks.hpp),
 // with sigma (0.6 .. 1.4), the sky gain (log-uniform in 1.5 .. 30: an overcast sky over bright
 // ground up to a clear sky over dark ground) and the lights drawn per environment from a fixed
-// seed; 6 environments, 160 random texels each. The reference is
+// seed; 10 environments, 256 random texels each. The reference is
 // the exact LD of each 256^2 cube (ibl::ld_texel_sum at ld_texel_sum_level) at random texel
 // directions; the error is the relative RMSE of luminance there (what ibl-bake's check reports),
 // the mean over the environments.
-constexpr int natural_envs = 6;
-constexpr int natural_dirs = 160;
+constexpr int natural_envs = 10;
+constexpr int natural_dirs = 256;
 
 double hash_unit(std::uint32_t a, std::uint32_t b) {
     return double(ibl::detail::rr_hash(ibl::detail::rr_hash(a * 0x9e3779b9u + 0x51ed27u) ^ (b * 0x85ebca6bu)) >> 8) * 0x1p-24;

@@ -40,7 +40,7 @@
 // * ld_texel_sum(cube, level, dirs, r, w, ex): the exact GGX LD of a cubemap level taken as
 //   constant over each texel, by a deterministic sum over every texel t (no sampling noise, and no
 //   correlation with any sampler's points: reference_ld draws the Hammersley points filtered
-//   importance sampling draws, so at equal counts the two share their errors):
+//   importance sampling draws, so at equal counts their errors are not independent):
 //     LD(R) = sum_t L_t int_t K / sum_t int_t K,   K(l) = D(h) k(R.l),  h = (R + l) / |R + l|,
 //   with k(mu) = mu (n.l) or G1(mu) (ld_weight::g1) and int_t K the kernel over the texel: its
 //   value at the texel centre times the texel's exact solid angle, or, for texels within

@@ -188,8 +188,8 @@ inline constexpr int level0_ref_k = 16;
 /// levels ibl::reference_ld_sky (analytic sky: GGX IS of the sky, quadrature of the sun's cap)
 /// or, for maps and cubes, ibl::ld_texel_sum over `cube` (the source cube the chain is filtered
 /// from, before any sun extraction) at ibl::ld_texel_sum_level: the exact LD of that cube, no
-/// sampling noise, and no Hammersley points shared with filtered importance sampling (which
-/// reference_ld at the chain's own sample count would share, hiding FIS's error). The chain's LD
+/// sampling noise, and no Hammersley points shared with filtered importance sampling (reference_ld
+/// at a level's own sample count draws that level's directions). The chain's LD
 /// weight throughout. One definition for the bake's check and the probe set's.
 std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cubemap<float>& cube,
                                           const std::vector<std::array<int, 3>>& texels, int n,
