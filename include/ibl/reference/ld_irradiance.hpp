@@ -49,10 +49,12 @@
 //   K at their centres. D from sin^2 + alpha^2 cos^2 of theta_h = (|R - l|^2 + alpha^2 |R + l|^2) / 4
 //   (no cancellation near R). The centre rule's relative error in a texel is about
 //   (texel / lobe width)^2 / 6 (0.2% at the 8-texel resolution; the ratio cancels most of it);
-//   below alpha = texel / 16 (r < 0.06 on a 256^2 face) the 16 x 16 cap leaves the lobe under-resolved.
-//   Cost: 6 n^2 kernel evaluations per direction (about 1.5 ns each, vectorised in double), plus
-//   s^2 per near texel. ld_texel_sum_level(cube, r) picks a coarser level of an exact-solid-angle
-//   chain where the lobe spans >= 10 of its texels (relative error <= 2e-4 measured; see there).
+//   below alpha = texel / 4 (r < 0.044 on a 256^2 face) the 16 x 16 cap leaves fewer than 8
+//   sub-texels across the lobe, and the error grows as (texel / 16 / lobe width)^2.
+//   Cost: 6 n^2 kernel evaluations per direction (about 2 ns each on one core of the 2-core VM,
+//   vectorised in double: bench_sun, BM_ld_texel_sum), plus s^2 per near texel.
+//   ld_texel_sum_level(cube, r) picks a coarser level of an exact-solid-angle chain where the lobe
+//   spans >= 10 of its texels (relative RMSE <= 3e-4 measured; see there).
 // * irradiance_texel_sum(cube, level, normals, ex): the brute-force sum over every texel t of one
 //   cubemap level, E(n) = sum_t L_t Omega_t max(0, n.d_t), with the exact texel solid angles
 //   Omega_t (cube_texel_solid_angle) and the texel-centre directions d_t (cube_texel_direction),
@@ -336,9 +338,10 @@ inline double ld_sum_kernel(const vec3<double>& R, const vec3<double>& l, double
 /// min(alpha / 10, 1 / 32) for GGX roughness r (clamped to [0, 1]), else level 0: the level
 /// ld_texel_sum may sum instead of level 0 when the chain's mips are exact solid-angle averages.
 /// A coarser level moves each texel's flux to its centre; measured against level 0 on the
-/// courtyard HDRI at 256^2, 200 directions (research/fast_tap_study.cpp, "reference"): relative
-/// RMSE 7e-5 (r = 0.4, level 1), 1.8e-4 (r = 0.6, level 2), 1.2e-4 (r = 1, level 2); r = 0.2 stays
-/// at level 0 (level 1 would be 9e-4).
+/// courtyard and studio HDRIs at 256^2, 400 directions per roughness (research/fast_tap_study.cpp):
+/// relative RMSE 7e-5 .. 2.8e-4 at r = 0.4 .. 1 (levels 1, 2); r = 0.2 stays at level 0 (level 1
+/// would be 9e-4). The largest single error measured: 6.1e-4 on the built-in sky's sun (10^4 times
+/// the sky) at r = 0.6, level 2 (bench_sun, BM_ld_texel_sum).
 template <class T> int ld_texel_sum_level(const cubemap<T>& c, double roughness) {
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
     const double max_texel = std::min(alpha_from_roughness(r) / 10.0, 1.0 / 32.0);
