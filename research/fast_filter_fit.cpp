@@ -429,15 +429,20 @@ template <class Evaluator> fit_result fit_with(const Evaluator& ev, const fit_ca
     return best;
 }
 
-fit_result fit(const std::vector<probe>& probes, const fit_case& c, bool show) {
+/// f(the objective's evaluator for case c, initialised).
+template <class F> auto with_evaluator(const std::vector<probe>& probes, const fit_case& c, F&& f) {
     if (g_natural) {
         natural_evaluator ev{&g_envs, c, {}};
         ev.init();
-        return fit_with(ev, c, show);
+        return f(ev);
     }
     evaluator ev{&probes, c, {}, {}};
     ev.init();
-    return fit_with(ev, c, show);
+    return f(ev);
+}
+
+fit_result fit(const std::vector<probe>& probes, const fit_case& c, bool show) {
+    return with_evaluator(probes, c, [&](const auto& ev) { return fit_with(ev, c, show); });
 }
 
 } // namespace
@@ -493,32 +498,16 @@ int main(int argc, char** argv) {
         return bad ? 1 : 0;
     }
     if (show_r >= 0.0 && fis) {
-        double e = 0.0;
-        if (g_natural) {
-            natural_evaluator ev{&g_envs, {ibl::ld_weight::n_dot_l, show_r, show_budget}, {}};
-            ev.init();
-            e = ev.error_fis(show_budget);
-        } else {
-            evaluator ev{&probes, {ibl::ld_weight::n_dot_l, show_r, show_budget}, {}, {}};
-            ev.init();
-            e = ev.error_fis(show_budget);
-        }
+        const double e = with_evaluator(probes, {ibl::ld_weight::n_dot_l, show_r, show_budget},
+                                        [&](const auto& ev) { return ev.error_fis(show_budget); });
         std::printf("fis r %.2f samples %u: error %.4f\n", show_r, show_budget, e);
         return 0;
     }
     if (show_r >= 0.0) {
         const fit_result r = fit(probes, {ibl::ld_weight::n_dot_l, show_r, show_budget}, true);
         const ibl::fast_tap_shape cur = ibl::fast_shape(show_r, show_budget, ibl::ld_weight::n_dot_l);
-        double cur_e = 0.0;
-        if (g_natural) {
-            natural_evaluator ev{&g_envs, {ibl::ld_weight::n_dot_l, show_r, show_budget}, {}};
-            ev.init();
-            cur_e = ev.error(cur);
-        } else {
-            evaluator ev{&probes, {ibl::ld_weight::n_dot_l, show_r, show_budget}, {}, {}};
-            ev.init();
-            cur_e = ev.error(cur);
-        }
+        const double cur_e = with_evaluator(probes, {ibl::ld_weight::n_dot_l, show_r, show_budget},
+                                            [&](const auto& ev) { return ev.error(cur); });
         std::printf("the compiled-in table: tail %.4f bias %+.4f  error %.4f\n", cur.tail, cur.lod_bias, cur_e);
         std::printf("best: tail %.4f bias %+.4f  error %.4f (FIS with %u samples: %.4f)\n", r.shape.tail, r.shape.lod_bias,
                     r.error, show_budget, r.fis_error);
