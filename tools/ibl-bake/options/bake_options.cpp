@@ -18,19 +18,18 @@ namespace ibl_bake {
 quality_settings settings_for(quality q) {
     switch (q) {
     case quality::low:
-        return {"low", 2, 64, false, ibl::dfg_quadrature_nodes{6, 6, 12, 6}, 2048, 1024, 16, 4, 1u << 13, 2};
+        return {"low", 2, 64, false, ibl::dfg_quadrature_nodes{6, 6, 12, 6}, 1024, 16, 4, 1u << 13, 2};
     case quality::high:
-        return {"high", 8, 2048, true, ibl::dfg_quadrature_nodes{16, 16, 32, 16}, 1u << 15, 8192, 48, 8, 1u << 18, 4};
+        return {"high", 8, 2048, true, ibl::dfg_quadrature_nodes{16, 16, 32, 16}, 8192, 48, 8, 1u << 18, 4};
     case quality::standard:
     default:
-        return {"default", 4, 512, true, ibl::dfg_quadrature_nodes{12, 12, 24, 12}, 1u << 13, 4096, 32, 6, 1u << 16, 4};
+        return {"default", 4, 512, true, ibl::dfg_quadrature_nodes{12, 12, 24, 12}, 4096, 32, 6, 1u << 16, 4};
     }
 }
 
 quality_settings check_settings_for(quality_settings q, check_mode checks) {
     if (checks != check_mode::fast) return q;
     q.ref_grid = std::max(3, q.ref_grid - 3);
-    q.ld_ref_samples = std::max(256u, q.ld_ref_samples / 4);
     q.sky_ref_samples = std::max(256u, q.sky_ref_samples / 4);
     q.split_sum_samples = std::max(1u << 10, q.split_sum_samples / 8);
     return q;

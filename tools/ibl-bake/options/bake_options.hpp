@@ -178,7 +178,6 @@ struct quality_settings {
     std::uint32_t prefilter_samples; ///< GGX samples per texel and level (filtered IS)
     bool trilinear;                  ///< prefilter reads two source levels per sample
     ibl::dfg_quadrature_nodes dfg_nodes;
-    std::uint32_t ld_ref_samples;    ///< reference LD (lat-long sources) per texel
     std::uint32_t sky_ref_samples;   ///< reference LD of the sky without its sun per texel
     int sun_cap_nodes;               ///< reference: radial nodes over the sun cap
     int ref_grid;                    ///< specular check: ref_grid^2 texels per face and level
@@ -189,7 +188,7 @@ struct quality_settings {
 quality_settings settings_for(quality q);
 
 /// The quality's settings with the check knobs of a --checks mode: full keeps them; fast takes a
-/// coarser texel grid (ref_grid - 3, at least 3), a quarter of the reference samples and an
+/// coarser texel grid (ref_grid - 3, at least 3), a quarter of the sky's reference samples and an
 /// eighth of the split-sum reference's (docs/ibl-bake.md "Checks"); none keeps them (no check runs).
 quality_settings check_settings_for(quality_settings q, check_mode checks);
 

@@ -256,10 +256,11 @@ void run_probe_bake(const bake_options& opt, std::FILE* out) {
     rj.end_object();
     rj.key("check").begin_object();
     rj.key("reference").value("level 0: texel mean (16x16 sub-samples) of the capture; levels >= 1: ibl::reference_ld_sky "
-                              "(built-in sky) or ibl::reference_ld on the capture (GGX IS, double), with the chain's LD weight");
+                              "(built-in sky) or ibl::ld_texel_sum, the exact LD of the capture's cube (a texel sum in "
+                              "double), with the chain's LD weight");
     rj.key("texels").value("per level: a grid per face plus the 3x3 block around the brightest direction (the full bake's "
                            "specular check with --checks fast's grid and samples)");
-    rj.key("grid").value(qc.ref_grid).key("ld_reference_samples").value(qc.ld_ref_samples);
+    rj.key("grid").value(qc.ref_grid);
     rj.key("sky_reference_samples").value(qc.sky_ref_samples);
     rj.end_object();
     rj.key("probes").begin_array();

@@ -430,10 +430,11 @@ std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cube
             for (std::size_t i = b; i < e; ++i) {
                 const auto& t = texels[i];
                 const dvec3 d = ibl::cube_texel_direction<double>(t[0], t[1], t[2], n);
-                if (mirror) ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], n, level0_ref_k);
-                else if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
-                    ref[i] = ibl::reference_ld_sky(env, d, roughness, qs.sky_ref_samples, qs.sun_cap_nodes, w);
-                else ref[i] = ibl::reference_ld(env, d, roughness, qs.ld_ref_samples, w);
+                // Maps and cubes reach here only for the mirror level: their rougher levels took the texel sum.
+                if constexpr (std::is_same_v<std::decay_t<decltype(env)>, ibl::sky_environment<double>>)
+                    ref[i] = mirror ? ibl::cube_texel_mean(env, t[0], t[1], t[2], n, level0_ref_k)
+                                    : ibl::reference_ld_sky(env, d, roughness, qs.sky_ref_samples, qs.sun_cap_nodes, w);
+                else ref[i] = ibl::cube_texel_mean(env, t[0], t[1], t[2], n, level0_ref_k);
             }
         });
         return 0;

@@ -236,7 +236,7 @@ std::vector<table_row> specular_stage::rows() const {
         std::snprintf(name, sizeof name, "  l%d %dx%d r=%.2f", c.virtual_level, c.size, c.size, c.roughness); // level 0 = mirror
         const std::string ref = c.virtual_level == 0 ? "texel mean " + std::to_string(level0_ref_k) + "^2"
                                 : analytic_      ? "ref: sky IS + sun cap quadrature"
-                                                 : "ref: GGX IS " + std::to_string(qs_.ld_ref_samples) + " spp";
+                                                 : "ref: exact texel sum";
         table_row r{name, ref, std::to_string(c.texels) + " texels", c.ref_ms, fmt2("rel RMSE %.3g, overshoot %.3g", c.m.rel_rmse, c.m.max_ratio)};
         r.detail = true;
         rows.push_back(r);
