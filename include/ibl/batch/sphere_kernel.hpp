@@ -16,14 +16,17 @@
 //  * convolve_lanes<W>: W output texels of one face row. Per tap, lane loop 1 rotates the tap
 //    direction into each texel's frame, selects the face branch-free (lane_cube_coord) and forms
 //    the bilinear address and weights (vectorisable); lane loop 2 reads the 2 x 2 texels and
-//    accumulates, the four channels of a texel as one 4-wide operation. Accumulation is in float
+//    accumulates, the four channels of a texel as one 4-wide operation. Loop 1 of the next tap runs
+//    before loop 2 of the current one (a one-tap software pipeline), so loop 2 never reads back
+//    addresses stored just before it. Accumulation is in float
 //    in blocks of tap_block taps whose sums are added to the totals (error ~ (tap_block + taps /
 //    tap_block) eps instead of taps * eps). The fourth channel (1 in every texel; its blend is
 //    exactly 1) sums the tap weights in that order: tap_weight_sum, bit for bit, and the
 //    normaliser of a normalised table, so a source of ones returns exactly 1. (That channel is
 //    what keeps the blend 4-wide: a padding channel whose sum went unused was dropped by the
 //    compiler, which then split the three live channels into a 2-wide and a scalar part.)
-//  * convolve_row: one face row in chunks of convolve_width lanes, the tail at width 1.
+//  * convolve_row: one face row in chunks of convolve_width (16) lanes, the tail in chunks of 8, 4
+//    and 1.
 // Determinism: every output texel is a fixed sequence of operations on the taps and the source.
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
@@ -147,9 +150,49 @@ IBL_FUNC_VOID void lane_cube_coord(float dx, float dy, float dz, int& face, floa
     t = t0 > 0.f ? (t0 < 1.f ? t0 : 1.f) : 0.f;
 }
 
+/// The addresses and bilinear weights of one tap for W lanes (lane loop 1's output).
+template <std::size_t W> struct lane_taps {
+    int idx[W];         ///< texel index of the 2 x 2 block's top-left texel
+    float wx[W], wy[W]; ///< bilinear weights within the block
+    int stride = 3;     ///< the tap level's row stride
+    float w = 0.f;      ///< the tap's weight
+};
+
+/// Lane loop 1 for tap i: rotate the tap direction into each lane's frame, select the face
+/// (branch-free) and address the 2 x 2 texels.
+template <std::size_t W>
+inline void lane_tap_address(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, std::size_t i,
+                             lane_taps<W>& o) noexcept {
+    const float lx = taps.x[i], ly = taps.y[i], lz = taps.z[i];
+    const packed_cube::level& lv = src.levels[std::size_t(taps.level[i])];
+    const float nf = lv.nf;
+    const int n = lv.n, st = lv.stride, fs = lv.face_stride, off = lv.offset;
+    o.stride = st;
+    o.w = taps.w[i];
+    for (std::size_t k = 0; k < W; ++k) {
+        const float dx = fr.tx[k] * lx + fr.bx[k] * ly + fr.nx[k] * lz;
+        const float dy = fr.ty[k] * lx + fr.by[k] * ly + fr.ny[k] * lz;
+        const float dz = fr.tz[k] * lx + fr.bz[k] * ly + fr.nz[k] * lz;
+        int face;
+        float s, t;
+        lane_cube_coord(dx, dy, dz, face, s, t);
+        const float fx = s * nf + 0.5f; // bordered coordinate, in [0.5, n + 0.5]
+        const float fy = t * nf + 0.5f;
+        const int ix = int(fx), iy = int(fy);
+        const int x0 = ix < n ? ix : n, y0 = iy < n ? iy : n;
+        o.wx[k] = fx - float(x0);
+        o.wy[k] = fy - float(y0);
+        o.idx[k] = off + face * fs + y0 * st + x0;
+    }
+}
+
 /// Convolves W output directions (one chunk of a face row): out[k] = factor * sum w L, factor
 /// computed per lane from its weight channel for a normalised table (the same float division as
-/// make_taps', on the same sum: the same bits as taps.factor).
+/// make_taps', on the same sum: the same bits as taps.factor). Software-pipelined by one tap: lane
+/// loop 1 of tap i + 1 runs before lane loop 2 of tap i, so the addresses that loop 2 reads back
+/// were stored a whole tap earlier (read straight after their vector stores they stall the
+/// pipeline at every tap: docs/ARCHITECTURE.md, "The batch kernel"). The arithmetic per texel
+/// is unchanged by the order.
 template <std::size_t W>
 void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, vec3<float>* out) noexcept {
     float tot[W][4], blk[W][4];
@@ -157,39 +200,23 @@ void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_fr
         for (int c = 0; c < 4; ++c) tot[k][c] = 0.f;
     const float* data = src.data.data();
     const std::size_t count = taps.w.size();
+    lane_taps<W> lt[2];
+    if (count > 0) lane_tap_address(src, taps, fr, 0, lt[0]);
     for (std::size_t b = 0; b < count; b += tap_block) {
         for (std::size_t k = 0; k < W; ++k)
             for (int c = 0; c < 4; ++c) blk[k][c] = 0.f;
         const std::size_t e = b + tap_block < count ? b + tap_block : count;
         for (std::size_t i = b; i < e; ++i) {
-            const float lx = taps.x[i], ly = taps.y[i], lz = taps.z[i], w = taps.w[i];
-            const packed_cube::level& lv = src.levels[std::size_t(taps.level[i])];
-            const float nf = lv.nf;
-            const int n = lv.n, st = lv.stride, fs = lv.face_stride, off = lv.offset;
-            int idx[W];
-            float wx[W], wy[W];
-            // Lane loop 1: rotate, select the face, address the 2 x 2 texels (branch-free).
-            for (std::size_t k = 0; k < W; ++k) {
-                const float dx = fr.tx[k] * lx + fr.bx[k] * ly + fr.nx[k] * lz;
-                const float dy = fr.ty[k] * lx + fr.by[k] * ly + fr.ny[k] * lz;
-                const float dz = fr.tz[k] * lx + fr.bz[k] * ly + fr.nz[k] * lz;
-                int face;
-                float s, t;
-                lane_cube_coord(dx, dy, dz, face, s, t);
-                const float fx = s * nf + 0.5f; // bordered coordinate, in [0.5, n + 0.5]
-                const float fy = t * nf + 0.5f;
-                const int ix = int(fx), iy = int(fy);
-                const int x0 = ix < n ? ix : n, y0 = iy < n ? iy : n;
-                wx[k] = fx - float(x0);
-                wy[k] = fy - float(y0);
-                idx[k] = off + face * fs + y0 * st + x0;
-            }
+            const lane_taps<W>& cur = lt[i & 1];
+            if (i + 1 < count) lane_tap_address(src, taps, fr, i + 1, lt[(i + 1) & 1]);
             // Lane loop 2: bilinear blend (a + w (b - a), exact on equal texels) and accumulate,
             // four channels at a time (RGB + the weight channel).
+            const std::size_t st = std::size_t(cur.stride);
+            const float w = cur.w;
             for (std::size_t k = 0; k < W; ++k) {
-                const float* p = data + 4 * std::size_t(idx[k]);
-                const float* q = p + 4 * std::size_t(st);
-                const float a = wx[k], bw = wy[k];
+                const float* p = data + 4 * std::size_t(cur.idx[k]);
+                const float* q = p + 4 * st;
+                const float a = cur.wx[k], bw = cur.wy[k];
                 for (int c = 0; c < 4; ++c) {
                     const float top = p[c] + a * (p[4 + c] - p[c]);
                     const float bot = q[c] + a * (q[4 + c] - q[c]);
@@ -207,8 +234,9 @@ void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_fr
     }
 }
 
-/// Lane width of the fast path (a face row is processed in chunks of W, the tail at width 1).
-inline constexpr std::size_t convolve_width = 8;
+/// Lane width of the fast path: a face row is processed in chunks of W, its tail in chunks of 8,
+/// 4 and 1 (every width computes a texel by the same operations; docs/ARCHITECTURE.md, "The batch kernel").
+inline constexpr std::size_t convolve_width = 16;
 
 /// Lane k of fr: the tangent frame of texel (x, y) of face `face` of an n x n level.
 template <std::size_t W>
@@ -219,20 +247,23 @@ inline void load_lane_frame(lane_frames<W>& fr, std::size_t k, int face, int x, 
     fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
 }
 
-/// Convolves row y of face `face` of an n x n output level into out[0..n).
-inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
-    constexpr std::size_t W = convolve_width;
-    int x = 0;
+/// Chunks of W lanes of row y from x while they fit; returns the first texel not done.
+template <std::size_t W>
+inline int convolve_chunks(const packed_cube& src, const tap_table& taps, int face, int x, int y, int n, vec3<float>* out) {
     for (; x + int(W) <= n; x += int(W)) {
         lane_frames<W> fr;
         for (std::size_t k = 0; k < W; ++k) load_lane_frame(fr, k, face, x + int(k), y, n);
         convolve_lanes<W>(src, taps, fr, out + x);
     }
-    for (; x < n; ++x) {
-        lane_frames<1> fr;
-        load_lane_frame(fr, 0, face, x, y, n);
-        convolve_lanes<1>(src, taps, fr, out + x);
-    }
+    return x;
+}
+
+/// Convolves row y of face `face` of an n x n output level into out[0..n).
+inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
+    int x = convolve_chunks<convolve_width>(src, taps, face, 0, y, n, out);
+    x = convolve_chunks<8>(src, taps, face, x, y, n, out);
+    x = convolve_chunks<4>(src, taps, face, x, y, n, out);
+    convolve_chunks<1>(src, taps, face, x, y, n, out);
 }
 
 } // namespace detail
