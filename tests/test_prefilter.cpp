@@ -180,6 +180,18 @@ TEST_CASE("prefilter: the default options are the tuned schedule (512 at level 1
     CHECK(ibl::doubling_prefilter_samples(512, 0) == 512);
     CHECK(ibl::doubling_prefilter_samples(512, 1000) == 16384);
     CHECK(ibl::doubling_prefilter_samples(0, 3) == 0);
+    // The equal-cost schedule (the fast filter's default): four times the samples per level, the
+    // same cap, never below its start.
+    const std::uint32_t fast[] = {64, 256, 1024, 4096, 16384, 16384, 16384};
+    for (int l = 1; l <= 7; ++l) {
+        CHECK(ibl::equal_cost_prefilter_samples(64, l) == fast[l - 1]);
+        CHECK(ibl::default_prefilter_samples(ibl::prefilter_method::fast, l) == fast[l - 1]);
+    }
+    CHECK(ibl::equal_cost_prefilter_samples(64, 0) == 64);
+    CHECK(ibl::equal_cost_prefilter_samples(3000, 3) == 16384);
+    CHECK(ibl::equal_cost_prefilter_samples(20000, 5) == 20000);
+    CHECK(ibl::equal_cost_prefilter_samples(8, 1000) == 16384);
+    CHECK(ibl::equal_cost_prefilter_samples(0, 3) == 0);
     // An explicit count is used at every level; samples_per_level overrides it where set.
     ibl::prefilter_options c;
     c.samples = 100;

@@ -182,11 +182,22 @@ inline std::uint32_t doubling_prefilter_samples(std::uint32_t level1_samples, in
     return std::uint32_t(std::min<std::uint64_t>(n, std::max(level1_samples, prefilter_max_scheduled_samples)));
 }
 
+/// The equal-cost schedule: level1_samples at level 1, four times as many at each coarser level
+/// (level l has a quarter of the texels of level l - 1, so every level costs the same taps), at
+/// most prefilter_max_scheduled_samples (levels < 1 get level1_samples; level1_samples = 0 gives 0).
+/// The fast filter's default (bake/prefilter_fast.hpp, "Cost").
+inline std::uint32_t equal_cost_prefilter_samples(std::uint32_t level1_samples, int level) {
+    std::uint64_t n = level1_samples;
+    for (int l = 1; l < level && n < prefilter_max_scheduled_samples; ++l) n *= 4;
+    return std::uint32_t(std::min<std::uint64_t>(n, std::max(level1_samples, prefilter_max_scheduled_samples)));
+}
+
 /// Default samples per texel at level l (the default schedule of the header comment): the
 /// doubling schedule from 512 at level 1 for filtered importance sampling (ibl-bake's default
-/// quality, with trilinear reads), from 1024 (the literature's count) for plain importance sampling.
+/// quality, with trilinear reads), from 1024 (the literature's count) for plain importance
+/// sampling; the equal-cost schedule from fast_default_samples for the fast filter.
 inline std::uint32_t default_prefilter_samples(prefilter_method method, int level) {
-    if (method == prefilter_method::fast) return doubling_prefilter_samples(fast_default_samples, level);
+    if (method == prefilter_method::fast) return equal_cost_prefilter_samples(fast_default_samples, level);
     return doubling_prefilter_samples(method == prefilter_method::importance ? 1024u : 512u, level);
 }
 

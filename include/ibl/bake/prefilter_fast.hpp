@@ -55,8 +55,12 @@
 // the same samples.
 //
 // Cost: N samples per texel (one bilinear tap each from the nearest level, the default plan's
-// reads; two with trilinear reads), the default schedule fast_default_samples * 2^(l - 1) against
-// 512 * 2^(l - 1) trilinear samples for filtered importance sampling.
+// reads; two with trilinear reads). The default schedule is fast_default_samples * 4^(l - 1), at
+// most prefilter_max_scheduled_samples (equal_cost_prefilter_samples: every level costs the taps of
+// level 1, since level l has a quarter of the texels of level l - 1), against 512 * 2^(l - 1)
+// trilinear samples for filtered importance sampling. Doubling (as filtered importance sampling
+// does) left levels 2-5 of real HDRIs 1.9-2.5x above the default filter's error; quadrupling puts
+// every level below it for about 2.5x the taps of doubling (docs/ibl-bake.md, "Fast filter").
 // Error and time: docs/ibl-bake.md ("Fast filter") and bench/bench_prefilter.cpp.
 //
 // Determinism: the table depends only on the roughness, N, the weight and the source's lod
@@ -97,10 +101,11 @@ inline double fast_lobe_scale(double roughness) noexcept {
     return 2.0 * std::atan(std::max(alpha_from_roughness(roughness), 1e-3));
 }
 
-/// Samples per texel at level 1 of the fast filter's default schedule (doubling per level, as
-/// default_prefilter_samples): an eighth of filtered importance sampling's default, read from the
-/// nearest level (one tap each: a sixteenth of its taps). At equal taps, nearest reads of twice
-/// the samples are the more accurate (docs/ibl-bake.md, "Fast filter", has the error and time).
+/// Samples per texel at level 1 of the fast filter's default schedule (four times as many per
+/// coarser level: equal_cost_prefilter_samples, default_prefilter_samples): an eighth of filtered
+/// importance sampling's default, read from the nearest level (one tap each: a sixteenth of its
+/// taps at level 1). At equal taps, nearest reads of twice the samples are the more accurate
+/// (docs/ibl-bake.md, "Fast filter", has the error and time).
 inline constexpr std::uint32_t fast_default_samples = 64;
 
 /// The tabulated shape (bake/prefilter_fast_tables.hpp) for a weight, a roughness and a sample

@@ -50,7 +50,8 @@ ibl::bake_plan probe_plan(const bake_options& opt, const quality_settings& qs) {
 struct probe_level_check {
     int size = 0;
     double roughness = 0.0;
-    std::uint32_t samples = 0;
+    std::uint32_t samples = 0; ///< the plan's (filtered importance sampling's); chain_samples gives the filter's
+    int level = 0;             ///< the level in the chain
     std::size_t texels = 0;
     ibl::error_metrics m;
     double ref_ms = 0.0;
@@ -97,6 +98,7 @@ std::vector<probe_level_check> check_chain(const source_env& src, const ibl::cub
         lc.size = chain.size(k);
         lc.roughness = lp.roughness;
         lc.samples = lp.samples;
+        lc.level = lp.level;
         const std::vector<std::array<int, 3>> texels = check_texels(lc.size, qc.ref_grid, light);
         const std::vector<dvec3> ref = chain_check_references(src, source, texels, lc.size, lp.level == 0, lc.roughness, qc, weight, ex);
         ibl::error_accumulator acc(floor);
@@ -276,7 +278,7 @@ void run_probe_bake(const bake_options& opt, std::FILE* out) {
             const probe_level_check& c = b.levels[k];
             rj.begin_object();
             rj.key("level").value(int(k)).key("size").value(c.size).key("roughness").value(c.roughness);
-            rj.key("samples").value(chain_samples(c.samples, opt.prefilter));
+            rj.key("samples").value(chain_samples(c.samples, opt.prefilter, c.level));
             rj.key("texels_compared").value(c.texels).key("rel_rmse").value(c.m.rel_rmse).key("nrmse").value(c.m.nrmse);
             rj.key("max_overshoot").value(c.m.max_ratio).key("max_rel").value(c.m.max_rel);
             rj.key("reference_time_ms").value(c.ref_ms);

@@ -442,8 +442,11 @@ std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cube
     return ref;
 }
 
-std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method) {
-    return method == prefilter_choice::fast ? std::max<std::uint32_t>(8, fis_samples / fast_samples_divisor) : fis_samples;
+std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, int level) {
+    if (method != prefilter_choice::fast) return fis_samples;
+    std::uint64_t n = std::max<std::uint32_t>(8, fis_samples / fast_samples_divisor);
+    for (int l = 1; l < level && n < ibl::prefilter_max_scheduled_samples; ++l) n *= 2;
+    return std::uint32_t(std::min<std::uint64_t>(n, std::max<std::uint64_t>(ibl::prefilter_max_scheduled_samples, fis_samples / fast_samples_divisor)));
 }
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
@@ -457,7 +460,7 @@ ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specul
     o.weight = w;
     o.method = method == prefilter_choice::fast ? ibl::prefilter_method::fast : ibl::prefilter_method::filtered_importance;
     for (const ibl::specular_level_plan& lp : sp.levels) // the mirror level copies the nearest source level
-        o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method),
+        o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method, lp.level),
                                 lp.level > 0 && lp.trilinear && method != prefilter_choice::fast});
     return ibl::cubemap<float>(ibl::prefilter(src, o, ex));
 }

@@ -197,7 +197,7 @@ level_check specular_stage::check_level(const bake_context& ctx, int k) const {
 std::vector<table_row> specular_stage::rows() const {
     const bool fast = method_ == prefilter_choice::fast;
     const std::string spp = sp_.first_level == 0 && sp_.levels.size() > 1 && sp_.levels[1].samples == qs_.prefilter_samples
-                                ? std::to_string(chain_samples(qs_.prefilter_samples, method_)) + "*2^(l-1) spp"
+                                ? std::to_string(chain_samples(qs_.prefilter_samples, method_, 1)) + (fast ? "*4^(l-1) spp" : "*2^(l-1) spp")
                                 : "planned spp";
     const std::string method = std::string(fast ? "GGX fast filter" : "GGX filtered IS") + (sp_.trilinear && !fast ? " (trilinear)" : "");
     const std::string brief = fast ? "GGX fast filter" : "GGX filtered IS";
@@ -289,9 +289,9 @@ void specular_stage::report(json_writer& j) const {
                           " source reads, N = V = R, weight " +
                           (weight_ == ibl::ld_weight::g1 ? "D G1(n.l)" : "D n.l"));
     j.key("ld_weight").value(to_string(weight_));
-    j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? chain_samples(sp_.levels[1].samples, method_) : 0u);
+    j.key("cost").begin_object().key("samples_per_texel").value(sp_.levels.size() > 1 ? chain_samples(sp_.levels[1].samples, method_, sp_.levels[1].level) : 0u);
     j.key("samples_per_level").begin_array();
-    for (const auto& l : sp_.levels) j.value(chain_samples(l.samples, method_));
+    for (const auto& l : sp_.levels) j.value(chain_samples(l.samples, method_, l.level));
     j.end_array();
     if (method_ == prefilter_choice::fast) j.key("lod_bias").value("per level: the fast table's shape (ibl::fast_shape)");
     else j.key("lod_bias").value(0.5);
@@ -335,7 +335,7 @@ void specular_stage::report_levels(json_writer& j) const {
         j.key("virtual_level").value(lp.level);
         j.key("size").value(chain_->size(int(k)));
         j.key("roughness").value(lp.roughness);
-        j.key("samples").value(chain_samples(lp.samples, method_));
+        j.key("samples").value(chain_samples(lp.samples, method_, lp.level));
         j.key("trilinear").value(lp.trilinear && method_ != prefilter_choice::fast);
         if (c) {
             j.key("texels_compared").value(c->texels);

@@ -225,11 +225,14 @@ ibl::cubemap<float> bake_source(const source_env& src, int n, int base_k, pool_e
 /// Bakes virtual levels [first, first + count) of the plan's chain (sizes base >> v) with the
 /// plan's samples and read mode per level: GGX filtered importance sampling, N = V = R.
 /// The fast filter's samples per level are the plan's (filtered importance sampling's) / 8, at
-/// least 8: 64 * 2^(l - 1) at the default quality (ibl::fast_default_samples), read from the
-/// nearest level (the library's default plan for the fast filter).
+/// least 8, times 2^(l - 1) at chain level l >= 1, at most ibl::prefilter_max_scheduled_samples:
+/// 64 * 4^(l - 1) at the default quality (ibl::fast_default_samples, the library's equal-cost
+/// schedule, ibl::equal_cost_prefilter_samples), read from the nearest level (the library's
+/// default plan for the fast filter).
 inline constexpr std::uint32_t fast_samples_divisor = 8;
-/// The samples a level of the chain is filtered with: the plan's for fis, the fast filter's for fast.
-std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method);
+/// The samples chain level `level` is filtered with: the plan's (fis_samples) for fis, the fast
+/// filter's for fast.
+std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, int level);
 /// The plan's chain filtered by `method` (ibl::prefilter with a level plan).
 /// fast_peaks: the fast filter's peak split (ibl::peak_split_options::max_peaks; 0 = off).
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,

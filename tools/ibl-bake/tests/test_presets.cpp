@@ -12,6 +12,7 @@
 #include "tool_test_support.hpp"
 #include "io/json_value.hpp"
 #include "io/ktx2.hpp"
+#include <ibl/bake/prefilter.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -145,16 +146,17 @@ TEST_CASE("--prefilter fast: the chain by the fast filter, named in report.json 
     REQUIRE(lf.size() >= 3);
     for (std::size_t l = 1; l < lf.size(); ++l) {
         CAPTURE(l);
-        // The fast filter's samples are the plan's / 8 (at least 8): 64 * 2^(l - 1) at the default
-        // quality, read from the nearest level.
-        CHECK(lf[l].find("samples")->number == std::max(8.0, li[l].find("samples")->number / 8.0));
-        CHECK(lf[l].find("samples")->number == 64.0 * std::exp2(double(l - 1)));
+        // The fast filter's samples are the plan's / 8 (at least 8) times 2^(l - 1): the
+        // equal-cost schedule 64 * 4^(l - 1) at the default quality, read from the nearest level.
+        CHECK(lf[l].find("samples")->number == std::max(8.0, li[l].find("samples")->number / 8.0) * std::exp2(double(l - 1)));
+        CHECK(lf[l].find("samples")->number == 64.0 * std::exp2(2.0 * double(l - 1)));
+        CHECK(lf[l].find("samples")->number == double(ibl::equal_cost_prefilter_samples(64, int(l))));
         CHECK_FALSE(lf[l].find("trilinear")->boolean);
         // Checked at the same texels against the same reference as the FIS chain.
         CHECK(std::isfinite(lf[l].find("rel_rmse")->number));
         CHECK(lf[l].find("texels_compared")->number == li[l].find("texels_compared")->number);
     }
-    // More samples (--quality high: 256 * 2^(l - 1)) give a smaller error on every level >= 1.
+    // More samples (--quality high: 256 * 4^(l - 1), at most 16384) give a smaller error on every level >= 1.
     REQUIRE(shell(base + "--prefilter fast --quality high --out " + (s / "high") + " >/dev/null") == 0);
     const auto high = ibl_examples::parse_json(slurp(s / "high/report.json"));
     const auto& lh = high.find("specular")->find("levels")->values;
