@@ -133,7 +133,8 @@ void BM_prefilter_fast_split(benchmark::State& state) {
 
 /// The default schedules at the sweeps' `levels` levels (the references' roughness per level):
 /// FIS (bias 0.5, trilinear reads, 512 samples at level 1 doubled per level) and the fast filter
-/// (32 at level 1 doubled, trilinear reads); the ratio of the two is measured in one run.
+/// (its default: 64 x 4^(l-1) nearest-level samples, the coarse tail and the peak split); the ratio
+/// of the two is measured in one run.
 void run_default(benchmark::State& state, ibl::prefilter_method method) {
     ibl::prefilter_options o;
     o.levels = levels;
@@ -208,7 +209,7 @@ void BM_prefilter_update_step(benchmark::State& state) {
 
 /// The batch kernel against its width-1 form: one level of the default chain (level 2 of the
 /// 256^2 sky with a sun: 64^2 faces, 1024 samples, trilinear reads), every face row computed by
-/// convolve_lanes<W> in chunks of W lanes (W = range(0): 8 is the library's convolve_width, 1 the
+/// convolve_lanes<W> in chunks of W lanes (W = range(0): 16 is the library's convolve_width, 1 the
 /// scalar form). Counters: taps per second, and the largest difference from the width-1 result
 /// (the lanes are independent: the same arithmetic per texel).
 template <std::size_t W> void convolve_level(const ibl::detail::packed_cube& src, const ibl::detail::tap_table& taps, int n,
