@@ -23,6 +23,7 @@
 
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <string>
@@ -175,24 +176,33 @@ void BM_irradiance(benchmark::State& state) {
 }
 
 /// A dynamic probe's slice: one prefilter_update::step of a budget of 2^k taps (k = range(1)) on
-/// the 256^2 source with the default options, one thread, the pass restarted when it finishes.
-/// Counters: taps per call, taps per second, the dearest call's taps over the budget (> 1 only
-/// where one face row costs more than the budget), and the largest difference of the finished chain from
-/// the one-shot prefilter (0: bit for bit).
+/// the 256^2 source with the default options of filtered importance sampling (range(2) = 0) or of
+/// the fast filter (1), one thread, the pass restarted when it finishes. Counters: taps per call,
+/// taps per second, the dearest call's taps over the budget (> 1 only where one work unit, a texel
+/// or a row's last texel with the row's finish, costs more than the budget), the slowest call's
+/// time over the budget's time at the run's mean rate, and the largest difference of the finished
+/// chain from the one-shot prefilter (0: bit for bit).
 void BM_prefilter_update_step(benchmark::State& state) {
     const ibl::cubemap<float>& src = source(int(state.range(0)));
     const std::uint64_t budget = std::uint64_t(1) << state.range(1);
-    ibl::prefilter_update<> up(src, ibl::prefilter_options{});
+    ibl::prefilter_options o;
+    if (state.range(2) == 1) o.method = ibl::prefilter_method::fast;
+    ibl::prefilter_update<> up(src, o);
     std::uint64_t taps = 0, calls = 0, most = 0;
+    double slowest = 0.0, total_s = 0.0;
     for (auto _ : state) {
         if (up.done()) up.set_source(src);
+        const auto t0 = std::chrono::steady_clock::now();
         const std::uint64_t t = up.step(budget);
+        const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        slowest = std::max(slowest, dt);
+        total_s += dt;
         taps += t;
         most = std::max(most, t);
         ++calls;
     }
     up.finish();
-    const ibl::specular_chain ref = ibl::prefilter(src, ibl::prefilter_options{}, ibl::thread_executor{2});
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::thread_executor{2});
     double diff = 0.0;
     for (int l = 0; l < ref.levels(); ++l)
         for (int f = 0; f < 6; ++f)
@@ -205,6 +215,8 @@ void BM_prefilter_update_step(benchmark::State& state) {
     state.counters["max_abs_vs_oneshot"] = diff;
     state.counters["pass_taps"] = double(up.total_taps());
     state.counters["max_call_over_budget"] = double(most) / double(budget);
+    // the budget's time at the mean rate: budget * total_s / taps
+    state.counters["slowest_call_over_budget_time"] = taps > 0 ? slowest / (double(budget) * total_s / double(taps)) : 0.0;
 }
 
 /// The batch kernel against its width-1 form: one level of the default chain (level 2 of the
@@ -347,7 +359,7 @@ BENCHMARK(BM_convolve_xsimd)
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 #endif
-BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget"})->ArgsProduct({{1}, {16, 18, 20}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget", "fast"})->ArgsProduct({{1}, {14, 16, 18, 20}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)
     ->ArgNames({"env", "spp"})

@@ -72,18 +72,52 @@ TEST_CASE("prefilter_update: any budget finishes with the one-shot chain, bit fo
         REQUIRE(up.result().has_value());
         CHECK(same_bits(*up.result(), ref));
         CHECK(up.result()->weight == ref.weight);
-        // the number of calls is predictable: a call computes max(1, budget / row taps) rows of a
-        // level (and goes on to the next level with what is left), and never exceeds the budget
-        // unless one row alone does
-        std::uint64_t bound = 0, largest_row = 0;
+        // the cost of a call is bounded and the number of calls predictable: a call computes work
+        // units (a texel, a row's last texel with the row's finish, a mirror row) until the next
+        // would exceed the budget, so it never exceeds max(budget, the dearest unit), and every
+        // call but the last spends more than budget - U (U the dearest unit)
+        std::uint64_t unit = 0;
         for (std::size_t k = 0; k < up.plan().size(); ++k) {
-            const std::uint64_t rows = 6 * std::uint64_t(up.level_size(k));
-            const std::uint64_t per_call = std::max<std::uint64_t>(1, budget / up.row_taps(k));
-            bound += (rows + per_call - 1) / per_call;
-            largest_row = std::max(largest_row, up.row_taps(k));
+            CHECK(up.unit_taps(k) <= up.row_taps(k));
+            unit = std::max(unit, up.unit_taps(k));
         }
-        CHECK(std::uint64_t(calls) <= bound);
-        CHECK(max_spent <= std::max(budget, largest_row));
+        CHECK(max_spent <= std::max(budget, unit));
+        if (budget > unit) CHECK(std::uint64_t(calls) <= (total + budget - unit) / (budget - unit + 1) + 1);
+    }
+}
+
+TEST_CASE("prefilter_update: rows dearer than the budget are computed in pieces, the same bits") {
+    // The fast filter with its peak split and coarse tail (whole-row finishes) and a coarse level
+    // whose rows cost far more than the budget: calls stay within the budget.
+    const ibl::cubemap<float> src = sky(64, 200.0f);
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    o.samples_per_level = {0, 16, 64, 256, 1024};
+    o.levels = 5;
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::serial_executor{});
+    for (std::uint64_t budget : {std::uint64_t(3000), std::uint64_t(4000)}) {
+        ibl::prefilter_update<> up(src, o);
+        std::uint64_t unit = 0, dearest_row = 0;
+        for (std::size_t k = 0; k < up.plan().size(); ++k) {
+            unit = std::max(unit, up.unit_taps(k));
+            dearest_row = std::max(dearest_row, up.row_taps(k));
+        }
+        REQUIRE(unit < budget);
+        REQUIRE(dearest_row > budget); // some row needs several calls
+        std::uint64_t spent = 0, max_spent = 0;
+        int calls = 0;
+        while (!up.done()) {
+            const std::uint64_t before = up.remaining_taps();
+            const std::uint64_t s = up.step(budget, ibl::thread_executor{2});
+            CHECK(up.remaining_taps() == (up.done() ? 0 : before - s));
+            spent += s;
+            max_spent = std::max(max_spent, s);
+            ++calls;
+            REQUIRE(calls < 100000);
+        }
+        CHECK(spent == up.total_taps());
+        CHECK(max_spent <= budget);
+        CHECK(same_bits(*up.result(), ref));
     }
 }
 

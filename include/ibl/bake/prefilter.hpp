@@ -498,7 +498,17 @@ public:
     /// receives the row before its peaks: this level as the coarse tail of the level before it reads it.
     void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,
              vec3<float>* base_out = nullptr) const {
-        convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
+        row_taps(lv, row, n, 0, n, out);
+        row_finish(lv, row, n, out, next, base_out);
+    }
+    /// The tap sums of texels [x0, x1) of a row (out: the row's start): row() in pieces, the same bits.
+    void row_taps(const prefilter_cube_level& lv, std::size_t row, int n, int x0, int x1, vec3<float>* out) const {
+        convolve_row_range(packed_, lv.taps, int(row) / n, int(row) % n, n, x0, x1, out);
+    }
+    /// The rest of row() once every texel of the row has its tap sum: the coarse tail, the copy
+    /// before the peaks, the peaks (whole-row operations).
+    void row_finish(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,
+                    vec3<float>* base_out = nullptr) const {
         if (next && lv.tail_share > 0.f) add_coarse_tail_row(*next, lv.tail_share, int(row) / n, int(row) % n, n, out);
         if (base_out) std::copy(out, out + n, base_out);
         splat_peaks_row(lv.peaks, int(row) / n, int(row) % n, n, out);

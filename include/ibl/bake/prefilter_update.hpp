@@ -4,20 +4,27 @@
 //
 // A renderer that re-filters a probe at run time (a captured reflection probe, a sky that changes
 // with the time of day) cannot spend a whole prefilter in one frame. prefilter_update holds the
-// work of one prefilter(source, opt) as a sequence of face rows, level by level in prefilter's
-// order (prefilter_plan's levels from the mirror level 0 to the roughest, or the reverse when the
-// fast filter's coarse tail reads each level's next: detail::prefilter_order), and step(budget) computes rows
-// until the next row would exceed `budget` source reads ("taps"); a row costs
-//     n_l           taps on a mirror level 0 (one read per texel),
-//     n_l (S_l T_l + ceil(P_l / 8) + C_l)   taps on a convolved level (S_l samples kept after
-//                   dropping n.l <= 0, T_l = 2 for trilinear reads, 1 for nearest; P_l the peaks of
-//                   the fast filter's split at that level, bake/prefilter_peaks.hpp, eight to a
-//                   tap; C_l = 1 with a coarse tail, its read of the next level),
-// so the cost of a call is bounded by max(budget, the dearest row) and proportional to the taps it
-// reports (bench/bench_prefilter.cpp, BM_prefilter_update_step). Every row is computed by exactly
-// the operations prefilter uses (the same tables, the same kernel, the same row order of
-// operations), so the finished chain equals prefilter(source, opt) bit for bit, whatever the
-// budgets of the calls and the executor within a call.
+// work of one prefilter(source, opt) as a sequence of work units, face row by face row, level by
+// level in prefilter's order (prefilter_plan's levels from the mirror level 0 to the roughest, or
+// the reverse when the fast filter's coarse tail reads each level's next: detail::prefilter_order),
+// and step(budget) computes units until the next unit would exceed `budget` source reads ("taps").
+// The units and their costs:
+//     a row of a mirror level 0:          n_l taps (one read per texel);
+//     a texel of a convolved level:       S_l T_l taps (S_l samples kept after dropping n.l <= 0,
+//                                         T_l = 2 for trilinear reads, 1 for nearest), and the
+//                                         last texel of a row also carries the row's finish,
+//                                         n_l (ceil(P_l / 8) + C_l) taps (P_l the peaks of the fast
+//                                         filter's split at that level, bake/prefilter_peaks.hpp,
+//                                         eight to a tap; C_l = 1 with a coarse tail, its read of
+//                                         the next level: whole-row operations, done once the
+//                                         row's texels all have their tap sums),
+// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: a texel of the
+// roughest level, or a row's last texel with the finish) and proportional to the taps it reports
+// (bench/bench_prefilter.cpp, BM_prefilter_update_step). A row may thus be computed over several
+// calls; every texel is computed by exactly the operations prefilter uses (the same tables, the
+// same kernel, whose lanes are independent, the same order of the whole-row operations), so the
+// finished chain equals prefilter(source, opt) bit for bit, whatever the budgets of the calls and
+// the executor within a call.
 //
 // Source changes. set_source(c) restarts the pass on the new source (the rows already computed
 // belong to the old one); result() keeps returning the last finished chain until the new pass
@@ -76,30 +83,71 @@ public:
             for (std::size_t k = 0; k < levels_.size(); ++k)
                 if (!levels_[k].mirror) {
                     levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
-                    levels_[k].taps_per_row = convolved_row_taps(levels_[k]);
+                    set_convolved_costs(levels_[k]);
                 }
         pos_ = 0;
         level_ = order_.front();
         row_ = 0;
+        col_ = 0;
         pass_done_ = false;
     }
 
-    /// Computes face rows until the next would exceed `budget` taps (at least one row when
-    /// budget > 0 and the pass is not finished), through the executor (rows are independent).
-    /// Returns the taps computed; finishing a pass publishes it as result().
+    /// Computes work units (header comment) until the next would exceed `budget` taps (at least
+    /// one unit when budget > 0 and the pass is not finished), through the executor (the pieces of
+    /// rows are independent). Returns the taps computed; finishing a pass publishes it as result().
     template <class Executor = serial_executor>
     std::uint64_t step(std::uint64_t budget, Executor&& ex = Executor{}) {
         std::uint64_t spent = 0;
         while (!pass_done_ && spent < budget) {
             const level_work& lw = levels_[level_];
-            const std::size_t rows_left = std::size_t(6 * lw.n) - row_;
-            std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_left, (budget - spent) / lw.taps_per_row));
-            if (rows == 0 && spent == 0) rows = 1; // progress: one row even above the budget
-            if (rows == 0) break;
-            run_rows(row_, row_ + rows, ex);
-            spent += rows * lw.taps_per_row;
-            row_ += rows;
-            if (row_ == std::size_t(6 * lw.n)) next_level();
+            const std::size_t rows_total = std::size_t(6 * lw.n);
+            if (lw.mirror) {
+                std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
+                if (rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
+                if (rows == 0) break;
+                pieces_.clear();
+                for (std::size_t r = row_; r < row_ + rows; ++r) pieces_.push_back({r, 0, lw.n, true});
+                spent += rows * lw.taps_per_row;
+                row_ += rows;
+            } else {
+                // Whole rows while they fit, then the texels of the next row that fit without its
+                // last (which carries the row's finish).
+                pieces_.clear();
+                std::uint64_t s = spent;
+                std::size_t r = row_;
+                int x = col_;
+                while (r < rows_total) {
+                    const std::uint64_t left = std::uint64_t(lw.n - x), room = budget - s;
+                    const std::uint64_t rest = left * lw.texel_taps + lw.finish_taps;
+                    if (rest <= room) {
+                        pieces_.push_back({r, x, lw.n, true});
+                        s += rest;
+                        ++r;
+                        x = 0;
+                        if (s == budget) break;
+                        continue;
+                    }
+                    const std::uint64_t k = std::min(room / lw.texel_taps, left - 1);
+                    if (k > 0) {
+                        pieces_.push_back({r, x, x + int(k), false});
+                        s += k * lw.texel_taps;
+                        x += int(k);
+                    } else if (s == 0) { // progress: one unit even above the budget
+                        const bool last = left == 1;
+                        pieces_.push_back({r, x, x + 1, last});
+                        s += lw.texel_taps + (last ? lw.finish_taps : 0);
+                        if (last) ++r, x = 0;
+                        else ++x;
+                    }
+                    break;
+                }
+                if (pieces_.empty()) break;
+                spent = s;
+                row_ = r;
+                col_ = x;
+            }
+            run_pieces(ex);
+            if (row_ == rows_total) next_level();
         }
         return spent;
     }
@@ -121,17 +169,23 @@ public:
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
-        std::uint64_t t = std::uint64_t(6 * levels_[level_].n - int(row_)) * levels_[level_].taps_per_row;
+        std::uint64_t t = std::uint64_t(6 * levels_[level_].n - int(row_)) * levels_[level_].taps_per_row -
+                          std::uint64_t(col_) * levels_[level_].texel_taps;
         for (std::size_t p = pos_ + 1; p < order_.size(); ++p)
             t += std::uint64_t(6 * levels_[order_[p]].n) * levels_[order_[p]].taps_per_row;
         return t;
     }
     /// The pass's plan (prefilter_plan of the options for this source).
     const std::vector<prefilter_level>& plan() const noexcept { return plan_; }
-    /// Face size of output level k and the taps of one of its rows (k < plan().size()): a budget
-    /// of at least the largest row's taps keeps every call within the budget.
+    /// Face size of output level k, the taps of one of its rows and of its dearest work unit
+    /// (k < plan().size(); header comment): a budget of at least the largest unit_taps keeps every
+    /// call within the budget.
     int level_size(std::size_t k) const noexcept { return levels_[k].n; }
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
+    std::uint64_t unit_taps(std::size_t k) const noexcept {
+        const level_work& lw = levels_[k];
+        return lw.mirror ? lw.taps_per_row : lw.texel_taps + lw.finish_taps;
+    }
 
 private:
     /// Peak evaluations counted as one tap in the budget (bake/prefilter_peaks.hpp: about ten
@@ -143,16 +197,26 @@ private:
         detail::prefilter_base_read base{};  ///< the mirror level's read
         detail::prefilter_cube_level conv{}; ///< a convolved level's taps and peaks
         double tail_roughness = -1.0;        ///< >= 0: reads its coarse tail from the next level
-        std::uint64_t taps_per_row = 1;
+        std::uint64_t taps_per_row = 1;      ///< n texel_taps + finish_taps (a mirror row: n)
+        std::uint64_t texel_taps = 1;        ///< a convolved texel's tap sum
+        std::uint64_t finish_taps = 0;       ///< a convolved row's finish: its tail reads and peaks
         std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
         std::vector<vec3<float>> before_peaks; ///< the texels before the peaks, when the level before reads this one
         std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
     };
 
-    static std::uint64_t convolved_row_taps(const level_work& lw) noexcept {
-        return std::max<std::uint64_t>(1, std::uint64_t(lw.n) * (lw.conv.taps.w.size() +
-                                                                  (lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
-                                                                  (lw.conv.tail_share > 0.f ? 1u : 0u)));
+    /// A piece of a row: texels [x0, x1) of row `row`; finish: the row's whole-row operations after them.
+    struct piece {
+        std::size_t row = 0;
+        int x0 = 0, x1 = 0;
+        bool finish = false;
+    };
+
+    static void set_convolved_costs(level_work& lw) noexcept {
+        lw.texel_taps = std::max<std::uint64_t>(1, lw.conv.taps.w.size());
+        lw.finish_taps = std::uint64_t(lw.n) * ((lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
+                                                (lw.conv.tail_share > 0.f ? 1u : 0u));
+        lw.taps_per_row = std::uint64_t(lw.n) * lw.texel_taps + lw.finish_taps;
     }
 
     void plan_levels() {
@@ -172,7 +236,7 @@ private:
             } else {
                 lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_);
                 lw.conv = src_->level(*source_, lp, lw.tail_roughness);
-                lw.taps_per_row = convolved_row_taps(lw);
+                set_convolved_costs(lw);
             }
             lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
             levels_.push_back(std::move(lw));
@@ -182,22 +246,30 @@ private:
         order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
-    template <class Executor> void run_rows(std::size_t begin, std::size_t end, Executor& ex) {
+    template <class Executor> void run_pieces(Executor& ex) {
         level_work& lw = levels_[level_];
         const int n = lw.n;
         const cubemap<float>* next =
             lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next : nullptr;
-        ex(end - begin, [&](std::size_t b, std::size_t e) {
-            for (std::size_t r = begin + b; r < begin + e; ++r) {
-                vec3<float>* out = lw.texels.data() + r * std::size_t(n);
-                if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
-                else src_->row(lw.conv, r, n, out, next, lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + r * std::size_t(n));
+        ex(pieces_.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) {
+                const piece& p = pieces_[i];
+                vec3<float>* out = lw.texels.data() + p.row * std::size_t(n);
+                if (lw.mirror) {
+                    detail::prefilter_base_row(*source_, n, lw.base, p.row, out);
+                    continue;
+                }
+                src_->row_taps(lw.conv, p.row, n, p.x0, p.x1, out);
+                if (p.finish)
+                    src_->row_finish(lw.conv, p.row, n, out, next,
+                                     lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + p.row * std::size_t(n));
             }
         });
     }
 
     void next_level() {
         row_ = 0;
+        col_ = 0;
         // The finished level as the coarse tail of the level before it in the plan.
         if (level_ > 0 && levels_[level_ - 1].tail_roughness >= 0.0) {
             const level_work& lw = levels_[level_];
@@ -228,6 +300,8 @@ private:
     int first_size_ = 1;
     std::vector<std::size_t> order_; ///< the levels in the order prefilter computes them
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
+    int col_ = 0;                ///< the next texel of row_ (a convolved row computed in pieces)
+    std::vector<piece> pieces_;  ///< the current call's pieces
     bool pass_done_ = false;
     std::optional<specular_chain> result_;
 };

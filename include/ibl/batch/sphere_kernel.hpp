@@ -25,8 +25,8 @@
 //    normaliser of a normalised table, so a source of ones returns exactly 1. (That channel is
 //    what keeps the blend 4-wide: a padding channel whose sum went unused was dropped by the
 //    compiler, which then split the three live channels into a 2-wide and a scalar part.)
-//  * convolve_row: one face row in chunks of convolve_width (16) lanes, the tail in chunks of 8, 4
-//    and 1.
+//  * convolve_row / convolve_row_range: a face row (or a run of its texels) in chunks of
+//    convolve_width (16) lanes, the tail in chunks of 8, 4 and 1.
 // Determinism: every output texel is a fixed sequence of operations on the taps and the source.
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
@@ -247,10 +247,12 @@ inline void load_lane_frame(lane_frames<W>& fr, std::size_t k, int face, int x, 
     fr.nx[k] = f.n.x, fr.ny[k] = f.n.y, fr.nz[k] = f.n.z;
 }
 
-/// Chunks of W lanes of row y from x while they fit; returns the first texel not done.
+/// Chunks of W lanes of texels [x, x1) of row y while they fit (out: the row's start); returns the
+/// first texel not done.
 template <std::size_t W>
-inline int convolve_chunks(const packed_cube& src, const tap_table& taps, int face, int x, int y, int n, vec3<float>* out) {
-    for (; x + int(W) <= n; x += int(W)) {
+inline int convolve_chunks(const packed_cube& src, const tap_table& taps, int face, int x, int x1, int y, int n,
+                           vec3<float>* out) {
+    for (; x + int(W) <= x1; x += int(W)) {
         lane_frames<W> fr;
         for (std::size_t k = 0; k < W; ++k) load_lane_frame(fr, k, face, x + int(k), y, n);
         convolve_lanes<W>(src, taps, fr, out + x);
@@ -258,12 +260,21 @@ inline int convolve_chunks(const packed_cube& src, const tap_table& taps, int fa
     return x;
 }
 
+/// Convolves texels [x0, x1) of row y of face `face` of an n x n output level into out[x0..x1)
+/// (out: the row's start), in chunks of convolve_width, then 8, 4 and 1. Every texel gets the same
+/// bits whatever the range it is computed in (the lanes are independent): prefilter_update
+/// computes a row in pieces.
+inline void convolve_row_range(const packed_cube& src, const tap_table& taps, int face, int y, int n, int x0, int x1,
+                               vec3<float>* out) {
+    int x = convolve_chunks<convolve_width>(src, taps, face, x0, x1, y, n, out);
+    x = convolve_chunks<8>(src, taps, face, x, x1, y, n, out);
+    x = convolve_chunks<4>(src, taps, face, x, x1, y, n, out);
+    convolve_chunks<1>(src, taps, face, x, x1, y, n, out);
+}
+
 /// Convolves row y of face `face` of an n x n output level into out[0..n).
 inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
-    int x = convolve_chunks<convolve_width>(src, taps, face, 0, y, n, out);
-    x = convolve_chunks<8>(src, taps, face, x, y, n, out);
-    x = convolve_chunks<4>(src, taps, face, x, y, n, out);
-    convolve_chunks<1>(src, taps, face, x, y, n, out);
+    convolve_row_range(src, taps, face, y, n, 0, n, out);
 }
 
 } // namespace detail
