@@ -33,10 +33,11 @@
 // fast filter's peaks (bake/prefilter_peaks.hpp) are split again from each new source.
 //
 // Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
-// level) and pack it into the kernel's layout (passes over its texels); a finished level that a
-// coarse tail reads is copied with its borders (one pass over its texels); the last step of a pass
-// assembles the chain's cubemap and its borders (one pass over the output texels). All are linear and small next to the
-// convolution (hundreds of taps per texel).
+// level), pack it into the kernel's layout (passes over its texels) and allocate the chain under
+// construction (a first pass; later passes reuse the storage of the result they replace: the rows
+// are written in place and the finished chain is swapped in, with only its borders to fill); a
+// finished level that a coarse tail reads is copied with its borders (one pass over its texels).
+// All are linear and small next to the convolution (hundreds of taps per texel).
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
 // prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
@@ -85,6 +86,9 @@ public:
                     levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
                     set_convolved_costs(levels_[k]);
                 }
+        // The chain under construction (the rows are written into it; outside the budget).
+        if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
+            back_.emplace(first_size_, int(levels_.size()));
         pos_ = 0;
         level_ = order_.front();
         row_ = 0;
@@ -200,7 +204,6 @@ private:
         std::uint64_t taps_per_row = 1;      ///< n texel_taps + finish_taps (a mirror row: n)
         std::uint64_t texel_taps = 1;        ///< a convolved texel's tap sum
         std::uint64_t finish_taps = 0;       ///< a convolved row's finish: its tail reads and peaks
-        std::vector<vec3<float>> texels;     ///< cubemap order (face, y, x)
         std::vector<vec3<float>> before_peaks; ///< the texels before the peaks, when the level before reads this one
         std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
     };
@@ -238,11 +241,11 @@ private:
                 lw.conv = src_->level(*source_, lp, lw.tail_roughness);
                 set_convolved_costs(lw);
             }
-            lw.texels.assign(std::size_t(6) * std::size_t(lw.n) * std::size_t(lw.n), vec3<float>(0.0f));
             levels_.push_back(std::move(lw));
         }
         for (std::size_t k = 1; k < levels_.size(); ++k)
-            if (levels_[k - 1].tail_roughness >= 0.0) levels_[k].before_peaks.assign(levels_[k].texels.size(), vec3<float>(0.0f));
+            if (levels_[k - 1].tail_roughness >= 0.0)
+                levels_[k].before_peaks.assign(std::size_t(6) * std::size_t(levels_[k].n) * std::size_t(levels_[k].n), vec3<float>(0.0f));
         order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
@@ -251,10 +254,14 @@ private:
         const int n = lw.n;
         const cubemap<float>* next =
             lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next : nullptr;
+        // The rows' storage, taken before the work items (texel_ref marks the borders stale).
+        outs_.resize(pieces_.size());
+        for (std::size_t i = 0; i < pieces_.size(); ++i)
+            outs_[i] = &back_->texel_ref(int(pieces_[i].row) / n, 0, int(pieces_[i].row) % n, int(level_));
         ex(pieces_.size(), [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const piece& p = pieces_[i];
-                vec3<float>* out = lw.texels.data() + p.row * std::size_t(n);
+                vec3<float>* out = outs_[i];
                 if (lw.mirror) {
                     detail::prefilter_base_row(*source_, n, lw.base, p.row, out);
                     continue;
@@ -280,13 +287,15 @@ private:
             level_ = order_[pos_];
             return;
         }
-        cubemap<float> out(first_size_, int(levels_.size()));
-        for (int k = 0; k < int(levels_.size()); ++k) {
-            const level_work& lw = levels_[std::size_t(k)];
-            out.fill(k, [&](int f, int x, int y) { return lw.texels[cube_texel_index(f, x, y, lw.n)]; });
+        // The finished chain becomes the result; the previous result's storage becomes the chain
+        // under construction of the next pass (no copy; a first pass leaves it to set_source).
+        back_->update_borders();
+        if (result_) {
+            std::swap(static_cast<cubemap<float>&>(*result_), *back_);
+        } else {
+            result_.emplace(std::move(*back_), opt_.weight, opt_.policy.mapping);
+            back_.reset();
         }
-        out.update_borders();
-        result_.emplace(std::move(out), opt_.weight, opt_.policy.mapping);
         pos_ = 0;
         level_ = order_.front();
         pass_done_ = true;
@@ -302,8 +311,10 @@ private:
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
     int col_ = 0;                ///< the next texel of row_ (a convolved row computed in pieces)
     std::vector<piece> pieces_;  ///< the current call's pieces
+    std::vector<vec3<float>*> outs_; ///< their rows in the chain under construction
     bool pass_done_ = false;
     std::optional<specular_chain> result_;
+    std::optional<cubemap<float>> back_; ///< the chain under construction (rows written in place)
 };
 
 } // namespace ibl
