@@ -178,8 +178,8 @@ void BM_irradiance(benchmark::State& state) {
 /// A dynamic probe's slice: one prefilter_update::step of a budget of 2^k taps (k = range(1)) on
 /// the 256^2 source with the default options of filtered importance sampling (range(2) = 0) or of
 /// the fast filter (1), one thread, the pass restarted when it finishes. Counters: taps per call,
-/// taps per second, the dearest call's taps over the budget (> 1 only where one work unit, a texel
-/// or a row's last texel with the row's finish, costs more than the budget), the slowest call's
+/// taps per second, the dearest call's taps over the budget (> 1 only where one work unit, a tap of
+/// a chunk of 16 lanes or a row's last tap with the row's finish, costs more than the budget), the slowest call's
 /// time over the budget's time at the run's mean rate, and the largest difference of the finished
 /// chain from the one-shot prefilter (0: bit for bit).
 void BM_prefilter_update_step(benchmark::State& state) {

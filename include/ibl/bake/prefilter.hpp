@@ -505,6 +505,12 @@ public:
     void row_taps(const prefilter_cube_level& lv, std::size_t row, int n, int x0, int x1, vec3<float>* out) const {
         convolve_row_range(packed_, lv.taps, int(row) / n, int(row) % n, n, x0, x1, out);
     }
+    /// Taps [st.next, end) of W lanes of a level (their frames fr): row_taps below a texel
+    /// (prefilter_update), the same operations as convolve_lanes.
+    template <std::size_t W>
+    void lanes_part(const prefilter_cube_level& lv, const lane_frames<W>& fr, lane_sums<W>& st, std::size_t end) const {
+        convolve_lanes_part<W>(packed_, lv.taps, fr, st, end);
+    }
     /// The rest of row() once every texel of the row has its tap sum: the coarse tail, the copy
     /// before the peaks, the peaks (whole-row operations).
     void row_finish(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,

@@ -10,21 +10,27 @@
 // and step(budget) computes units until the next unit would exceed `budget` source reads ("taps").
 // The units and their costs:
 //     a row of a mirror level 0:          n_l taps (one read per texel);
-//     a texel of a convolved level:       S_l T_l taps (S_l samples kept after dropping n.l <= 0,
-//                                         T_l = 2 for trilinear reads, 1 for nearest), and the
-//                                         last texel of a row also carries the row's finish,
-//                                         n_l (ceil(P_l / 8) + C_l) taps (P_l the peaks of the fast
-//                                         filter's split at that level, bake/prefilter_peaks.hpp,
-//                                         eight to a tap; C_l = 1 with a coarse tail, its read of
-//                                         the next level: whole-row operations, done once the
-//                                         row's texels all have their tap sums),
-// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: a texel of the
-// roughest level, or a row's last texel with the finish) and proportional to the taps it reports
-// (bench/bench_prefilter.cpp, BM_prefilter_update_step). A row may thus be computed over several
-// calls; every texel is computed by exactly the operations prefilter uses (the same tables, the
-// same kernel, whose lanes are independent, the same order of the whole-row operations), so the
-// finished chain equals prefilter(source, opt) bit for bit, whatever the budgets of the calls and
-// the executor within a call.
+//     a tap of a chunk of W lanes of a    W taps (the kernel works on a row in chunks of 16
+//     convolved level:                    texels, the row's tail in chunks of 8, 4 and 1:
+//                                         convolve_row; a texel has S_l T_l taps, S_l samples kept
+//                                         after dropping n.l <= 0, T_l = 2 for trilinear reads, 1
+//                                         for nearest), and the last tap of a row's last chunk
+//                                         also carries the row's finish, n_l (ceil(P_l / 8) + C_l)
+//                                         taps (P_l the peaks of the fast filter's split at that
+//                                         level, bake/prefilter_peaks.hpp, eight to a tap; C_l = 1
+//                                         with a coarse tail, its read of the next level:
+//                                         whole-row operations, done once the row's texels all
+//                                         have their tap sums),
+// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: 16 taps, or a
+// row's last tap with its finish) and proportional to the taps it reports
+// (bench/bench_prefilter.cpp, BM_prefilter_update_step). Whole rows that fit go through the
+// executor; a row that does not fit is computed chunk by chunk, and a chunk's taps may span calls:
+// its lanes' accumulators (detail::lane_sums) are kept between calls, and convolve_lanes_part
+// continues them with the same operations in the same order, at the full lane width. Every texel
+// is thus computed by exactly the operations prefilter uses (the same tables, the same kernel,
+// whose lanes are independent, the same order of the whole-row operations), so the finished chain
+// equals prefilter(source, opt) bit for bit, whatever the budgets of the calls and the executor
+// within a call.
 //
 // Source changes. set_source(c) restarts the pass on the new source (the rows already computed
 // belong to the old one); result() keeps returning the last finished chain until the new pass
@@ -92,66 +98,70 @@ public:
         pos_ = 0;
         level_ = order_.front();
         row_ = 0;
-        col_ = 0;
+        chunk_ = 0;
+        tap_ = 0;
         pass_done_ = false;
     }
 
     /// Computes work units (header comment) until the next would exceed `budget` taps (at least
-    /// one unit when budget > 0 and the pass is not finished), through the executor (the pieces of
-    /// rows are independent). Returns the taps computed; finishing a pass publishes it as result().
+    /// one unit when budget > 0 and the pass is not finished): whole face rows through the
+    /// executor (rows are independent), a row's chunks of lanes and the taps of a chunk on the
+    /// calling thread. Returns the taps computed; finishing a pass publishes it as result().
     template <class Executor = serial_executor>
     std::uint64_t step(std::uint64_t budget, Executor&& ex = Executor{}) {
         std::uint64_t spent = 0;
-        while (!pass_done_ && spent < budget) {
+        bool stop = false;
+        while (!pass_done_ && !stop && spent < budget) {
             const level_work& lw = levels_[level_];
             const std::size_t rows_total = std::size_t(6 * lw.n);
-            if (lw.mirror) {
+            if (chunk_ == 0 && tap_ == 0) { // at the start of a row: whole rows, in parallel
                 std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
-                if (rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
-                if (rows == 0) break;
-                pieces_.clear();
-                for (std::size_t r = row_; r < row_ + rows; ++r) pieces_.push_back({r, 0, lw.n, true});
-                spent += rows * lw.taps_per_row;
-                row_ += rows;
-            } else {
-                // Whole rows while they fit, then the texels of the next row that fit without its
-                // last (which carries the row's finish).
-                pieces_.clear();
-                std::uint64_t s = spent;
-                std::size_t r = row_;
-                int x = col_;
-                while (r < rows_total) {
-                    const std::uint64_t left = std::uint64_t(lw.n - x), room = budget - s;
-                    const std::uint64_t rest = left * lw.texel_taps + lw.finish_taps;
-                    if (rest <= room) {
-                        pieces_.push_back({r, x, lw.n, true});
-                        s += rest;
-                        ++r;
-                        x = 0;
-                        if (s == budget) break;
-                        continue;
+                if (lw.mirror && rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
+                if (rows > 0) {
+                    run_rows(row_, row_ + rows, ex);
+                    spent += rows * lw.taps_per_row;
+                    row_ += rows;
+                    if (row_ == rows_total) next_level();
+                    continue;
+                }
+                if (lw.mirror) break;
+            }
+            // A row that does not fit: its chunks of lanes, and the taps of a chunk, while they fit.
+            const std::uint64_t count = lw.conv.taps.w.size();
+            while (true) {
+                const auto [x0, w] = lw.chunks[chunk_];
+                const bool last = chunk_ + 1 == lw.chunks.size();
+                const std::uint64_t lanes = std::uint64_t(w), fin = last ? lw.finish_taps : 0;
+                const std::uint64_t left = count - tap_, room = budget - spent;
+                std::uint64_t k = left;
+                bool complete = true;
+                if (left * lanes + fin > room) { // the taps that fit, short of the one that carries the finish
+                    k = std::min<std::uint64_t>(room / lanes, last && left > 0 ? left - 1 : left);
+                    complete = false;
+                    if (k == 0) {
+                        if (spent > 0) {
+                            stop = true;
+                            break;
+                        }
+                        complete = left <= 1; // progress: one unit even above the budget
+                        k = complete ? left : 1;
                     }
-                    const std::uint64_t k = std::min(room / lw.texel_taps, left - 1);
-                    if (k > 0) {
-                        pieces_.push_back({r, x, x + int(k), false});
-                        s += k * lw.texel_taps;
-                        x += int(k);
-                    } else if (s == 0) { // progress: one unit even above the budget
-                        const bool last = left == 1;
-                        pieces_.push_back({r, x, x + 1, last});
-                        s += lw.texel_taps + (last ? lw.finish_taps : 0);
-                        if (last) ++r, x = 0;
-                        else ++x;
-                    }
+                }
+                run_chunk_taps(x0, w, tap_ + std::size_t(k));
+                spent += k * lanes + (complete ? fin : 0);
+                tap_ += std::size_t(k);
+                if (!complete) {
+                    stop = true;
                     break;
                 }
-                if (pieces_.empty()) break;
-                spent = s;
-                row_ = r;
-                col_ = x;
+                finish_chunk(x0, w);
+                tap_ = 0;
+                if (++chunk_ < lw.chunks.size()) continue;
+                chunk_ = 0;
+                finish_row();
+                if (++row_ == rows_total) next_level();
+                break;
             }
-            run_pieces(ex);
-            if (row_ == rows_total) next_level();
         }
         return spent;
     }
@@ -173,8 +183,10 @@ public:
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
-        std::uint64_t t = std::uint64_t(6 * levels_[level_].n - int(row_)) * levels_[level_].taps_per_row -
-                          std::uint64_t(col_) * levels_[level_].texel_taps;
+        const level_work& lw = levels_[level_];
+        std::uint64_t t = std::uint64_t(6 * lw.n - int(row_)) * lw.taps_per_row;
+        if (!lw.mirror) // the texels of the row's finished chunks and the taps of its current chunk
+            t -= std::uint64_t(lw.chunks[chunk_].first) * lw.texel_taps + std::uint64_t(lw.chunks[chunk_].second) * tap_;
         for (std::size_t p = pos_ + 1; p < order_.size(); ++p)
             t += std::uint64_t(6 * levels_[order_[p]].n) * levels_[order_[p]].taps_per_row;
         return t;
@@ -188,7 +200,7 @@ public:
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
-        return lw.mirror ? lw.taps_per_row : lw.texel_taps + lw.finish_taps;
+        return lw.mirror ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps;
     }
 
 private:
@@ -204,15 +216,9 @@ private:
         std::uint64_t taps_per_row = 1;      ///< n texel_taps + finish_taps (a mirror row: n)
         std::uint64_t texel_taps = 1;        ///< a convolved texel's tap sum
         std::uint64_t finish_taps = 0;       ///< a convolved row's finish: its tail reads and peaks
+        std::vector<std::pair<int, int>> chunks; ///< a row's chunks of lanes (first texel, width), as convolve_row
         std::vector<vec3<float>> before_peaks; ///< the texels before the peaks, when the level before reads this one
         std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
-    };
-
-    /// A piece of a row: texels [x0, x1) of row `row`; finish: the row's whole-row operations after them.
-    struct piece {
-        std::size_t row = 0;
-        int x0 = 0, x1 = 0;
-        bool finish = false;
     };
 
     static void set_convolved_costs(level_work& lw) noexcept {
@@ -220,6 +226,10 @@ private:
         lw.finish_taps = std::uint64_t(lw.n) * ((lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
                                                 (lw.conv.tail_share > 0.f ? 1u : 0u));
         lw.taps_per_row = std::uint64_t(lw.n) * lw.texel_taps + lw.finish_taps;
+        lw.chunks.clear();
+        int x = 0;
+        for (const int w : {int(detail::convolve_width), 8, 4, 1})
+            for (; x + w <= lw.n; x += w) lw.chunks.emplace_back(x, w);
     }
 
     void plan_levels() {
@@ -249,34 +259,76 @@ private:
         order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
-    template <class Executor> void run_pieces(Executor& ex) {
+    /// Whole rows [begin, end) of the current level, through the executor.
+    template <class Executor> void run_rows(std::size_t begin, std::size_t end, Executor& ex) {
         level_work& lw = levels_[level_];
         const int n = lw.n;
-        const cubemap<float>* next =
-            lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next : nullptr;
         // The rows' storage, taken before the work items (texel_ref marks the borders stale).
-        outs_.resize(pieces_.size());
-        for (std::size_t i = 0; i < pieces_.size(); ++i)
-            outs_[i] = &back_->texel_ref(int(pieces_[i].row) / n, 0, int(pieces_[i].row) % n, int(level_));
-        ex(pieces_.size(), [&](std::size_t b, std::size_t e) {
+        outs_.resize(end - begin);
+        for (std::size_t r = begin; r < end; ++r) outs_[r - begin] = row_out(r);
+        const cubemap<float>* next = next_level_cube();
+        ex(end - begin, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
-                const piece& p = pieces_[i];
+                const std::size_t r = begin + i;
                 vec3<float>* out = outs_[i];
-                if (lw.mirror) {
-                    detail::prefilter_base_row(*source_, n, lw.base, p.row, out);
-                    continue;
-                }
-                src_->row_taps(lw.conv, p.row, n, p.x0, p.x1, out);
-                if (p.finish)
-                    src_->row_finish(lw.conv, p.row, n, out, next,
-                                     lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + p.row * std::size_t(n));
+                if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
+                else src_->row(lw.conv, r, n, out, next, lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + r * std::size_t(n));
             }
         });
     }
 
+    vec3<float>* row_out(std::size_t r) {
+        const int n = levels_[level_].n;
+        return &back_->texel_ref(int(r) / n, 0, int(r) % n, int(level_));
+    }
+    const cubemap<float>* next_level_cube() const {
+        const level_work& lw = levels_[level_];
+        return lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next
+                                                                                                     : nullptr;
+    }
+    template <std::size_t W> detail::lane_sums<W>& sums() noexcept {
+        if constexpr (W == 16) return sums16_;
+        else if constexpr (W == 8) return sums8_;
+        else if constexpr (W == 4) return sums4_;
+        else return sums1_;
+    }
+    template <std::size_t W> void chunk_taps(int x0, std::size_t end) {
+        const level_work& lw = levels_[level_];
+        const int n = lw.n, face = int(row_) / n, y = int(row_) % n;
+        detail::lane_sums<W>& st = sums<W>();
+        if (tap_ == 0) st = detail::lane_sums<W>{};
+        detail::lane_frames<W> fr;
+        for (std::size_t k = 0; k < W; ++k) detail::load_lane_frame(fr, k, face, x0 + int(k), y, n);
+        src_->lanes_part(lw.conv, fr, st, end);
+    }
+    /// Taps [tap_, end) of the current row's chunk at x0 of w lanes.
+    void run_chunk_taps(int x0, int w, std::size_t end) {
+        static_assert(detail::convolve_width == 16, "the chunk widths of prefilter_update");
+        if (w == 16) chunk_taps<16>(x0, end);
+        else if (w == 8) chunk_taps<8>(x0, end);
+        else if (w == 4) chunk_taps<4>(x0, end);
+        else chunk_taps<1>(x0, end);
+    }
+    /// The outputs of the finished chunk at x0 of w lanes.
+    void finish_chunk(int x0, int w) {
+        const level_work& lw = levels_[level_];
+        vec3<float>* out = row_out(row_) + x0;
+        if (w == 16) detail::convolve_lanes_result(lw.conv.taps, sums16_, out);
+        else if (w == 8) detail::convolve_lanes_result(lw.conv.taps, sums8_, out);
+        else if (w == 4) detail::convolve_lanes_result(lw.conv.taps, sums4_, out);
+        else detail::convolve_lanes_result(lw.conv.taps, sums1_, out);
+    }
+    /// The whole-row operations of the current row once its chunks are done.
+    void finish_row() {
+        level_work& lw = levels_[level_];
+        src_->row_finish(lw.conv, row_, lw.n, row_out(row_), next_level_cube(),
+                         lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + row_ * std::size_t(lw.n));
+    }
+
     void next_level() {
         row_ = 0;
-        col_ = 0;
+        chunk_ = 0;
+        tap_ = 0;
         // The finished level as the coarse tail of the level before it in the plan.
         if (level_ > 0 && levels_[level_ - 1].tail_roughness >= 0.0) {
             const level_work& lw = levels_[level_];
@@ -309,9 +361,12 @@ private:
     int first_size_ = 1;
     std::vector<std::size_t> order_; ///< the levels in the order prefilter computes them
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
-    int col_ = 0;                ///< the next texel of row_ (a convolved row computed in pieces)
-    std::vector<piece> pieces_;  ///< the current call's pieces
-    std::vector<vec3<float>*> outs_; ///< their rows in the chain under construction
+    std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
+    detail::lane_sums<16> sums16_{};    ///< the current chunk's sums (by its width)
+    detail::lane_sums<8> sums8_{};
+    detail::lane_sums<4> sums4_{};
+    detail::lane_sums<1> sums1_{};
+    std::vector<vec3<float>*> outs_;    ///< the rows of a call's whole rows in the chain under construction
     bool pass_done_ = false;
     std::optional<specular_chain> result_;
     std::optional<cubemap<float>> back_; ///< the chain under construction (rows written in place)

@@ -27,6 +27,9 @@
 //    compiler, which then split the three live channels into a 2-wide and a scalar part.)
 //  * convolve_row / convolve_row_range: a face row (or a run of its texels) in chunks of
 //    convolve_width (16) lanes, the tail in chunks of 8, 4 and 1.
+//  * convolve_lanes_part / lane_sums: convolve_lanes over a range of its taps, the lanes'
+//    accumulators kept in between (prefilter_update's units below a texel), the same operations in
+//    the same order as one call.
 // Determinism: every output texel is a fixed sequence of operations on the taps and the source.
 
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
@@ -186,6 +189,71 @@ inline void lane_tap_address(const packed_cube& src, const tap_table& taps, cons
     }
 }
 
+/// The accumulators of W lanes part-way through a tap table: convolve_lanes split over several
+/// calls of convolve_lanes_part (prefilter_update's units below a texel), the same operations in
+/// the same order as one call.
+template <std::size_t W> struct lane_sums {
+    float tot[W][4] = {};
+    float blk[W][4] = {};
+    std::size_t next = 0; ///< the next tap
+};
+
+/// Taps [st.next, end) of convolve_lanes (end <= the table's size), continuing from st.
+template <std::size_t W>
+void convolve_lanes_part(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, lane_sums<W>& st,
+                         std::size_t end) noexcept {
+    const float* data = src.data.data();
+    const std::size_t count = taps.w.size();
+    std::size_t i = st.next;
+    // Local accumulators (the state's may alias the source's floats for the compiler).
+    float tot[W][4], blk[W][4];
+    for (std::size_t k = 0; k < W; ++k)
+        for (int c = 0; c < 4; ++c) tot[k][c] = st.tot[k][c], blk[k][c] = st.blk[k][c];
+    lane_taps<W> lt[2];
+    if (i < end) lane_tap_address(src, taps, fr, i, lt[i & 1]);
+    while (i < end) {
+        const std::size_t b = i - i % tap_block; // the block of tap i
+        const std::size_t e = b + tap_block < count ? b + tap_block : count;
+        const std::size_t stop = e < end ? e : end;
+        if (i == b)
+            for (std::size_t k = 0; k < W; ++k)
+                for (int c = 0; c < 4; ++c) blk[k][c] = 0.f;
+        for (; i < stop; ++i) {
+            const lane_taps<W>& cur = lt[i & 1];
+            if (i + 1 < end) lane_tap_address(src, taps, fr, i + 1, lt[(i + 1) & 1]);
+            // Lane loop 2: bilinear blend (a + w (b - a), exact on equal texels) and accumulate,
+            // four channels at a time (RGB + the weight channel).
+            const std::size_t rs = std::size_t(cur.stride);
+            const float w = cur.w;
+            for (std::size_t k = 0; k < W; ++k) {
+                const float* p = data + 4 * std::size_t(cur.idx[k]);
+                const float* q = p + 4 * rs;
+                const float a = cur.wx[k], bw = cur.wy[k];
+                for (int c = 0; c < 4; ++c) {
+                    const float top = p[c] + a * (p[4 + c] - p[c]);
+                    const float bot = q[c] + a * (q[4 + c] - q[c]);
+                    blk[k][c] += w * (top + bw * (bot - top));
+                }
+            }
+        }
+        if (i == e)
+            for (std::size_t k = 0; k < W; ++k)
+                for (int c = 0; c < 4; ++c) tot[k][c] += blk[k][c];
+    }
+    for (std::size_t k = 0; k < W; ++k)
+        for (int c = 0; c < 4; ++c) st.tot[k][c] = tot[k][c], st.blk[k][c] = blk[k][c];
+    st.next = i;
+}
+
+/// The W outputs once every tap is in st (st.next == the table's size).
+template <std::size_t W> void convolve_lanes_result(const tap_table& taps, const lane_sums<W>& st, vec3<float>* out) noexcept {
+    for (std::size_t k = 0; k < W; ++k) {
+        // tot[k][3] == tap_weight_sum(taps); reading it keeps the fourth channel (see the header).
+        const float f = taps.normalised ? (st.tot[k][3] > 0.f ? taps.scale / st.tot[k][3] : 0.f) : taps.factor;
+        out[k] = vec3<float>(st.tot[k][0] * f, st.tot[k][1] * f, st.tot[k][2] * f);
+    }
+}
+
 /// Convolves W output directions (one chunk of a face row): out[k] = factor * sum w L, factor
 /// computed per lane from its weight channel for a normalised table (the same float division as
 /// make_taps', on the same sum: the same bits as taps.factor). Software-pipelined by one tap: lane
@@ -195,43 +263,9 @@ inline void lane_tap_address(const packed_cube& src, const tap_table& taps, cons
 /// is unchanged by the order.
 template <std::size_t W>
 void convolve_lanes(const packed_cube& src, const tap_table& taps, const lane_frames<W>& fr, vec3<float>* out) noexcept {
-    float tot[W][4], blk[W][4];
-    for (std::size_t k = 0; k < W; ++k)
-        for (int c = 0; c < 4; ++c) tot[k][c] = 0.f;
-    const float* data = src.data.data();
-    const std::size_t count = taps.w.size();
-    lane_taps<W> lt[2];
-    if (count > 0) lane_tap_address(src, taps, fr, 0, lt[0]);
-    for (std::size_t b = 0; b < count; b += tap_block) {
-        for (std::size_t k = 0; k < W; ++k)
-            for (int c = 0; c < 4; ++c) blk[k][c] = 0.f;
-        const std::size_t e = b + tap_block < count ? b + tap_block : count;
-        for (std::size_t i = b; i < e; ++i) {
-            const lane_taps<W>& cur = lt[i & 1];
-            if (i + 1 < count) lane_tap_address(src, taps, fr, i + 1, lt[(i + 1) & 1]);
-            // Lane loop 2: bilinear blend (a + w (b - a), exact on equal texels) and accumulate,
-            // four channels at a time (RGB + the weight channel).
-            const std::size_t st = std::size_t(cur.stride);
-            const float w = cur.w;
-            for (std::size_t k = 0; k < W; ++k) {
-                const float* p = data + 4 * std::size_t(cur.idx[k]);
-                const float* q = p + 4 * st;
-                const float a = cur.wx[k], bw = cur.wy[k];
-                for (int c = 0; c < 4; ++c) {
-                    const float top = p[c] + a * (p[4 + c] - p[c]);
-                    const float bot = q[c] + a * (q[4 + c] - q[c]);
-                    blk[k][c] += w * (top + bw * (bot - top));
-                }
-            }
-        }
-        for (std::size_t k = 0; k < W; ++k)
-            for (int c = 0; c < 4; ++c) tot[k][c] += blk[k][c];
-    }
-    for (std::size_t k = 0; k < W; ++k) {
-        // tot[k][3] == tap_weight_sum(taps); reading it keeps the fourth channel (see the header).
-        const float f = taps.normalised ? (tot[k][3] > 0.f ? taps.scale / tot[k][3] : 0.f) : taps.factor;
-        out[k] = vec3<float>(tot[k][0] * f, tot[k][1] * f, tot[k][2] * f);
-    }
+    lane_sums<W> st;
+    convolve_lanes_part(src, taps, fr, st, taps.w.size());
+    convolve_lanes_result(taps, st, out);
 }
 
 /// Lane width of the fast path: a face row is processed in chunks of W, its tail in chunks of 8,
