@@ -498,15 +498,11 @@ public:
     /// receives the row before its peaks: this level as the coarse tail of the level before it reads it.
     void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,
              vec3<float>* base_out = nullptr) const {
-        row_taps(lv, row, n, 0, n, out);
+        convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
         row_finish(lv, row, n, out, next, base_out);
     }
-    /// The tap sums of texels [x0, x1) of a row (out: the row's start): row() in pieces, the same bits.
-    void row_taps(const prefilter_cube_level& lv, std::size_t row, int n, int x0, int x1, vec3<float>* out) const {
-        convolve_row_range(packed_, lv.taps, int(row) / n, int(row) % n, n, x0, x1, out);
-    }
-    /// Taps [st.next, end) of W lanes of a level (their frames fr): row_taps below a texel
-    /// (prefilter_update), the same operations as convolve_lanes.
+    /// Taps [st.next, end) of W lanes of a level (their frames fr): a row's tap sums below a texel
+    /// (prefilter_update), the same operations as convolve_row's lanes.
     template <std::size_t W>
     void lanes_part(const prefilter_cube_level& lv, const lane_frames<W>& fr, lane_sums<W>& st, std::size_t end) const {
         convolve_lanes_part<W>(packed_, lv.taps, fr, st, end);

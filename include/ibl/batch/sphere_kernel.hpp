@@ -25,8 +25,8 @@
 //    normaliser of a normalised table, so a source of ones returns exactly 1. (That channel is
 //    what keeps the blend 4-wide: a padding channel whose sum went unused was dropped by the
 //    compiler, which then split the three live channels into a 2-wide and a scalar part.)
-//  * convolve_row / convolve_row_range: a face row (or a run of its texels) in chunks of
-//    convolve_width (16) lanes, the tail in chunks of 8, 4 and 1.
+//  * convolve_row: a face row in chunks of convolve_width (16) lanes, the tail in chunks of 8, 4
+//    and 1.
 //  * convolve_lanes_part / lane_sums: convolve_lanes over a range of its taps, the lanes'
 //    accumulators kept in between (prefilter_update's units below a texel), the same operations in
 //    the same order as one call.
@@ -294,21 +294,13 @@ inline int convolve_chunks(const packed_cube& src, const tap_table& taps, int fa
     return x;
 }
 
-/// Convolves texels [x0, x1) of row y of face `face` of an n x n output level into out[x0..x1)
-/// (out: the row's start), in chunks of convolve_width, then 8, 4 and 1. Every texel gets the same
-/// bits whatever the range it is computed in (the lanes are independent): prefilter_update
-/// computes a row in pieces.
-inline void convolve_row_range(const packed_cube& src, const tap_table& taps, int face, int y, int n, int x0, int x1,
-                               vec3<float>* out) {
-    int x = convolve_chunks<convolve_width>(src, taps, face, x0, x1, y, n, out);
-    x = convolve_chunks<8>(src, taps, face, x, x1, y, n, out);
-    x = convolve_chunks<4>(src, taps, face, x, x1, y, n, out);
-    convolve_chunks<1>(src, taps, face, x, x1, y, n, out);
-}
-
-/// Convolves row y of face `face` of an n x n output level into out[0..n).
+/// Convolves row y of face `face` of an n x n output level into out[0..n): chunks of
+/// convolve_width lanes, then 8, 4 and 1 (prefilter_update keeps the same chunks).
 inline void convolve_row(const packed_cube& src, const tap_table& taps, int face, int y, int n, vec3<float>* out) {
-    convolve_row_range(src, taps, face, y, n, 0, n, out);
+    int x = convolve_chunks<convolve_width>(src, taps, face, 0, n, y, n, out);
+    x = convolve_chunks<8>(src, taps, face, x, n, y, n, out);
+    x = convolve_chunks<4>(src, taps, face, x, n, y, n, out);
+    convolve_chunks<1>(src, taps, face, x, n, y, n, out);
 }
 
 } // namespace detail

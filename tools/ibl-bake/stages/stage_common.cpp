@@ -444,9 +444,8 @@ std::vector<dvec3> chain_check_references(const source_env& src, const ibl::cube
 
 std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, int level) {
     if (method != prefilter_choice::fast) return fis_samples;
-    std::uint64_t n = std::max<std::uint32_t>(8, fis_samples / fast_samples_divisor);
-    for (int l = 1; l < level && n < ibl::prefilter_max_scheduled_samples; ++l) n *= 2;
-    return std::uint32_t(std::min<std::uint64_t>(n, std::max<std::uint64_t>(ibl::prefilter_max_scheduled_samples, fis_samples / fast_samples_divisor)));
+    // The plan's samples already double per level; one more doubling makes the equal-cost schedule.
+    return ibl::doubling_prefilter_samples(std::max<std::uint32_t>(8, fis_samples / fast_samples_divisor), level);
 }
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
