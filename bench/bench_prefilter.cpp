@@ -180,7 +180,7 @@ void BM_irradiance(benchmark::State& state) {
 /// the fast filter (1), one thread, the pass restarted when it finishes. Counters: taps per call,
 /// taps per second, the dearest call's taps over the budget (> 1 only where one work unit, a tap of
 /// a chunk of 16 lanes or a row's last tap with the row's finish, costs more than the budget), the slowest call's
-/// time over the budget's time at the run's mean rate, and the largest difference of the finished
+/// time and the 99th percentile of the calls' times over the budget's time at the run's mean rate, and the largest difference of the finished
 /// chain from the one-shot prefilter (0: bit for bit).
 void BM_prefilter_update_step(benchmark::State& state) {
     const ibl::cubemap<float>& src = source(int(state.range(0)));
@@ -190,12 +190,14 @@ void BM_prefilter_update_step(benchmark::State& state) {
     ibl::prefilter_update<> up(src, o);
     std::uint64_t taps = 0, calls = 0, most = 0;
     double slowest = 0.0, total_s = 0.0;
+    std::vector<double> times;
     for (auto _ : state) {
         if (up.done()) up.set_source(src);
         const auto t0 = std::chrono::steady_clock::now();
         const std::uint64_t t = up.step(budget);
         const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         slowest = std::max(slowest, dt);
+        times.push_back(dt);
         total_s += dt;
         taps += t;
         most = std::max(most, t);
@@ -216,7 +218,13 @@ void BM_prefilter_update_step(benchmark::State& state) {
     state.counters["pass_taps"] = double(up.total_taps());
     state.counters["max_call_over_budget"] = double(most) / double(budget);
     // the budget's time at the mean rate: budget * total_s / taps
-    state.counters["slowest_call_over_budget_time"] = taps > 0 ? slowest / (double(budget) * total_s / double(taps)) : 0.0;
+    const double budget_s = taps > 0 ? double(budget) * total_s / double(taps) : 0.0;
+    state.counters["slowest_call_over_budget_time"] = budget_s > 0.0 ? slowest / budget_s : 0.0;
+    if (!times.empty() && budget_s > 0.0) { // the 99th percentile of the calls' times over the budget's time
+        const auto p99 = times.begin() + std::ptrdiff_t((times.size() - 1) * 99 / 100);
+        std::nth_element(times.begin(), p99, times.end());
+        state.counters["p99_call_over_budget_time"] = *p99 / budget_s;
+    }
 }
 
 /// The batch kernel against its width-1 form: one level of the default chain (level 2 of the
@@ -262,6 +270,51 @@ const convolve_case& convolve_setup() {
         c = k;
     }
     return *c;
+}
+
+/// The machine's own spread of call times, the control of BM_prefilter_update_step: every call
+/// does the same amount of work, 2^range(0) taps of the batch kernel (chunks of 16 lanes of level 2
+/// of the sky with a sun, 32 trilinear samples: 1024 taps a chunk, cycling through the level's
+/// texels), so the calls differ only by what the machine does around them (interrupts, other
+/// processes, caches). Counters: the 99th percentile and the slowest call over the mean call.
+void BM_fixed_call_spread(benchmark::State& state) {
+    static const convolve_case* c = nullptr;
+    if (!c) {
+        const ibl::cubemap<float>& env = source(1);
+        auto* k = new convolve_case;
+        k->n = base >> 2;
+        const ibl::sphere_sample_table<float> table = ibl::make_ld_table_for<float>(
+            env, ibl::roughness_mip_policy{}.roughness(2.0, 6), 32, ibl::prefilter_method::filtered_importance, 0.5);
+        k->samples = table.size();
+        k->src = ibl::detail::pack_cube(env);
+        k->taps = ibl::detail::make_taps(table, int(k->src.levels.size()));
+        c = k;
+    }
+    const int n = c->n, chunks_per_row = n / 16;
+    const std::uint64_t chunk_taps = 16 * c->taps.w.size() * 2; // trilinear: two reads a sample
+    const std::uint64_t chunks = std::max<std::uint64_t>(1, (std::uint64_t(1) << state.range(0)) / chunk_taps);
+    std::vector<ibl::vec3<float>> out(16);
+    std::vector<double> times;
+    std::uint64_t next = 0;
+    for (auto _ : state) {
+        const auto t0 = std::chrono::steady_clock::now();
+        for (std::uint64_t i = 0; i < chunks; ++i, ++next) {
+            const int chunk = int(next % std::uint64_t(6 * n * chunks_per_row)), row = chunk / chunks_per_row;
+            ibl::detail::lane_frames<16> fr;
+            for (std::size_t k = 0; k < 16; ++k)
+                ibl::detail::load_lane_frame(fr, k, row / n, (chunk % chunks_per_row) * 16 + int(k), row % n, n);
+            ibl::detail::convolve_lanes<16>(c->src, c->taps, fr, out.data());
+            benchmark::DoNotOptimize(out.data());
+        }
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    }
+    double mean = 0.0;
+    for (const double t : times) mean += t / double(times.size());
+    const auto p99 = times.begin() + std::ptrdiff_t((times.size() - 1) * 99 / 100);
+    std::nth_element(times.begin(), p99, times.end());
+    state.counters["taps_per_call"] = double(chunks * chunk_taps);
+    state.counters["p99_call_over_mean"] = *p99 / mean;
+    state.counters["slowest_call_over_mean"] = *std::max_element(times.begin(), times.end()) / mean;
 }
 
 void set_tap_rate(benchmark::State& state, const convolve_case& c) {
@@ -360,6 +413,7 @@ BENCHMARK(BM_convolve_xsimd)
     ->UseRealTime();
 #endif
 BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget", "fast"})->ArgsProduct({{1}, {14, 16, 18, 20}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_fixed_call_spread)->ArgName("log2_taps")->DenseRange(14, 20, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)
     ->ArgNames({"env", "spp"})

@@ -353,6 +353,44 @@ TEST_CASE_TEMPLATE("cubemap: 1x1 per face", T, float, double) {
     }
 }
 
+TEST_CASE("cubemap: borders rebuilt a face at a time equal update_borders; validity follows the written levels") {
+    ibl::cubemap<float> a(8, 3);
+    for (int l = 0; l < 3; ++l)
+        a.fill(l, [&](int f, int x, int y) { return ibl::vec3<float>(float(f) + 0.1f * float(x), float(y) * 0.37f, float(l) - 0.3f * float(x * y)); });
+    ibl::cubemap<float> b = a;
+    a.update_borders();
+    CHECK(a.borders_valid());
+    CHECK_FALSE(b.borders_valid());
+    for (int l = 0; l < 3; ++l)
+        for (int f = 0; f < 6; ++f) {
+            CHECK_FALSE(b.borders_valid()); // faces still stale
+            b.update_borders(l, f);
+        }
+    CHECK(b.borders_valid());
+    bool same = true;
+    for (int l = 0; l < 3; ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = -1; y <= a.size(l); ++y)
+                for (int x = -1; x <= a.size(l); ++x)
+                    for (int c = 0; c < 3; ++c) same = same && a.texel(f, x, y, l)[c] == b.texel(f, x, y, l)[c];
+    CHECK(same);
+    // a write marks only its own level stale: rebuilding that level's faces suffices
+    b.set_texel(2, 1, 1, 1, ibl::vec3<float>(5.0f));
+    CHECK_FALSE(b.borders_valid());
+    for (int f = 0; f < 6; ++f) b.update_borders(1, f);
+    CHECK(b.borders_valid());
+    // and a face rebuilt before a later write to its level is stale again
+    b.update_borders(0, 0);
+    b.set_texel(0, 0, 0, 0, ibl::vec3<float>(1.0f));
+    for (int f = 1; f < 6; ++f) b.update_borders(0, f);
+    CHECK_FALSE(b.borders_valid());
+    b.update_borders(0, 0);
+    CHECK(b.borders_valid());
+    CHECK_THROWS_AS(b.update_borders(3, 0), std::invalid_argument);
+    CHECK_THROWS_AS(b.update_borders(0, 6), std::invalid_argument);
+    CHECK_THROWS_AS(b.update_borders(-1, 0), std::invalid_argument);
+}
+
 TEST_CASE_TEMPLATE("cubemap: sanitize zeroes NaN, inf and (optionally) negatives and counts texels", T, float, double) {
     ibl::cubemap<T> c(4);
     c.fill(0, [](int, int, int) { return v3<T>(1); });

@@ -20,9 +20,13 @@
 //                                         level, bake/prefilter_peaks.hpp, eight to a tap; C_l = 1
 //                                         with a coarse tail, its read of the next level:
 //                                         whole-row operations, done once the row's texels all
-//                                         have their tap sums),
-// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: 16 taps, or a
-// row's last tap with its finish) and proportional to the taps it reports
+//                                         have their tap sums);
+//     the borders of a face of a          ceil(B (4 n_l + 4) / 2) taps (two border texels to a
+//     finished level:                     tap; B = 2 when a coarse tail reads the level, whose
+//                                         copy before the peaks, as_next, has its borders too,
+//                                         else 1: cubemap::update_borders(level, face)),
+// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: 16 taps, a row's
+// last tap with its finish, or a face's borders) and proportional to the taps it reports
 // (bench/bench_prefilter.cpp, BM_prefilter_update_step). Whole rows that fit go through the
 // executor; a row that does not fit is computed chunk by chunk, and a chunk's taps may span calls:
 // its lanes' accumulators (detail::lane_sums) are kept between calls, and convolve_lanes_part
@@ -38,12 +42,16 @@
 // rebuilt only when the source's size or mip count changes (they depend on nothing else); the
 // fast filter's peaks (bake/prefilter_peaks.hpp) are split again from each new source.
 //
+// Storage. The rows are written in place into the chain under construction, and a level that a
+// coarse tail reads is written before its peaks into a cube of its own (as_next), row by row, so
+// nothing is copied when a level or a pass finishes: the faces' borders are work units, and the
+// finished chain is swapped with the previous result.
+//
 // Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
 // level), pack it into the kernel's layout (passes over its texels) and allocate the chain under
-// construction (a first pass; later passes reuse the storage of the result they replace: the rows
-// are written in place and the finished chain is swapped in, with only its borders to fill); a
-// finished level that a coarse tail reads is copied with its borders (one pass over its texels).
-// All are linear and small next to the convolution (hundreds of taps per texel).
+// construction and the as_next cubes (a first pass, or a source of another shape; later passes
+// reuse the storage of the result they replace). All are linear and small next to the convolution
+// (hundreds of taps per texel).
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
 // prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
@@ -100,6 +108,7 @@ public:
         row_ = 0;
         chunk_ = 0;
         tap_ = 0;
+        face_ = 0;
         pass_done_ = false;
     }
 
@@ -114,6 +123,14 @@ public:
         while (!pass_done_ && !stop && spent < budget) {
             const level_work& lw = levels_[level_];
             const std::size_t rows_total = std::size_t(6 * lw.n);
+            if (row_ == rows_total) { // the finished level's borders, a face per unit
+                if (spent > 0 && lw.border_taps > budget - spent) break;
+                back_->update_borders(int(level_), int(face_));
+                if (levels_[level_].as_next) levels_[level_].as_next->update_borders(0, int(face_));
+                spent += lw.border_taps;
+                if (++face_ == 6) next_level();
+                continue;
+            }
             if (chunk_ == 0 && tap_ == 0) { // at the start of a row: whole rows, in parallel
                 std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
                 if (lw.mirror && rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
@@ -121,7 +138,6 @@ public:
                     run_rows(row_, row_ + rows, ex);
                     spent += rows * lw.taps_per_row;
                     row_ += rows;
-                    if (row_ == rows_total) next_level();
                     continue;
                 }
                 if (lw.mirror) break;
@@ -159,7 +175,7 @@ public:
                 if (++chunk_ < lw.chunks.size()) continue;
                 chunk_ = 0;
                 finish_row();
-                if (++row_ == rows_total) next_level();
+                ++row_;
                 break;
             }
         }
@@ -178,17 +194,19 @@ public:
     /// Taps of a whole pass, and those still to compute in the current one.
     std::uint64_t total_taps() const noexcept {
         std::uint64_t t = 0;
-        for (const level_work& lw : levels_) t += std::uint64_t(6 * lw.n) * lw.taps_per_row;
+        for (const level_work& lw : levels_) t += level_taps(lw);
         return t;
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
         const level_work& lw = levels_[level_];
-        std::uint64_t t = std::uint64_t(6 * lw.n - int(row_)) * lw.taps_per_row;
-        if (!lw.mirror) // the texels of the row's finished chunks and the taps of its current chunk
-            t -= std::uint64_t(lw.chunks[chunk_].first) * lw.texel_taps + std::uint64_t(lw.chunks[chunk_].second) * tap_;
-        for (std::size_t p = pos_ + 1; p < order_.size(); ++p)
-            t += std::uint64_t(6 * levels_[order_[p]].n) * levels_[order_[p]].taps_per_row;
+        std::uint64_t t = std::uint64_t(6 - face_) * lw.border_taps;
+        if (row_ < std::size_t(6 * lw.n)) {
+            t += std::uint64_t(6 * lw.n - int(row_)) * lw.taps_per_row;
+            if (!lw.mirror) // the texels of the row's finished chunks and the taps of its current chunk
+                t -= std::uint64_t(lw.chunks[chunk_].first) * lw.texel_taps + std::uint64_t(lw.chunks[chunk_].second) * tap_;
+        }
+        for (std::size_t p = pos_ + 1; p < order_.size(); ++p) t += level_taps(levels_[order_[p]]);
         return t;
     }
     /// The pass's plan (prefilter_plan of the options for this source).
@@ -200,13 +218,17 @@ public:
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
-        return lw.mirror ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps;
+        return std::max(lw.border_taps, lw.mirror ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
     }
 
 private:
     /// Peak evaluations counted as one tap in the budget (bake/prefilter_peaks.hpp: about ten
     /// vectorised float operations against a bilinear tap's rotation, face selection and reads).
     static constexpr std::size_t peak_per_tap = 8;
+    /// Border texels counted as one tap (a copy from a neighbouring face, mostly one cache line per
+    /// texel along a column, against a tap's 8-12 texel reads and its arithmetic; measured by
+    /// bench/bench_prefilter.cpp, BM_prefilter_update_step).
+    static constexpr std::size_t border_per_tap = 2;
     struct level_work {
         int n = 1;
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
@@ -216,10 +238,14 @@ private:
         std::uint64_t taps_per_row = 1;      ///< n texel_taps + finish_taps (a mirror row: n)
         std::uint64_t texel_taps = 1;        ///< a convolved texel's tap sum
         std::uint64_t finish_taps = 0;       ///< a convolved row's finish: its tail reads and peaks
+        std::uint64_t border_taps = 1;       ///< the borders of a face (of the chain, and of as_next when kept)
         std::vector<std::pair<int, int>> chunks; ///< a row's chunks of lanes (first texel, width), as convolve_row
-        std::vector<vec3<float>> before_peaks; ///< the texels before the peaks, when the level before reads this one
-        std::optional<cubemap<float>> as_next; ///< this level as the previous one's coarse tail reads it
+        std::optional<cubemap<float>> as_next; ///< this level before its peaks, which the coarse tail of the level before reads
     };
+    /// The taps of a whole level: its rows and its faces' borders.
+    static std::uint64_t level_taps(const level_work& lw) noexcept {
+        return std::uint64_t(6 * lw.n) * lw.taps_per_row + 6 * lw.border_taps;
+    }
 
     static void set_convolved_costs(level_work& lw) noexcept {
         lw.texel_taps = std::max<std::uint64_t>(1, lw.conv.taps.w.size());
@@ -254,8 +280,9 @@ private:
             levels_.push_back(std::move(lw));
         }
         for (std::size_t k = 1; k < levels_.size(); ++k)
-            if (levels_[k - 1].tail_roughness >= 0.0)
-                levels_[k].before_peaks.assign(std::size_t(6) * std::size_t(levels_[k].n) * std::size_t(levels_[k].n), vec3<float>(0.0f));
+            if (levels_[k - 1].tail_roughness >= 0.0) levels_[k].as_next.emplace(levels_[k].n, 1);
+        for (level_work& lw : levels_) // a face's edges (4 n) and corners, in each cube that keeps the level
+            lw.border_taps = (std::uint64_t(4 * lw.n + 4) * (lw.as_next ? 2u : 1u) + border_per_tap - 1) / border_per_tap;
         order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
     }
 
@@ -265,14 +292,18 @@ private:
         const int n = lw.n;
         // The rows' storage, taken before the work items (texel_ref marks the borders stale).
         outs_.resize(end - begin);
-        for (std::size_t r = begin; r < end; ++r) outs_[r - begin] = row_out(r);
+        befores_.resize(end - begin);
+        for (std::size_t r = begin; r < end; ++r) {
+            outs_[r - begin] = row_out(r);
+            befores_[r - begin] = row_before_peaks(r);
+        }
         const cubemap<float>* next = next_level_cube();
         ex(end - begin, [&](std::size_t b, std::size_t e) {
             for (std::size_t i = b; i < e; ++i) {
                 const std::size_t r = begin + i;
                 vec3<float>* out = outs_[i];
                 if (lw.mirror) detail::prefilter_base_row(*source_, n, lw.base, r, out);
-                else src_->row(lw.conv, r, n, out, next, lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + r * std::size_t(n));
+                else src_->row(lw.conv, r, n, out, next, befores_[i]);
             }
         });
     }
@@ -280,6 +311,11 @@ private:
     vec3<float>* row_out(std::size_t r) {
         const int n = levels_[level_].n;
         return &back_->texel_ref(int(r) / n, 0, int(r) % n, int(level_));
+    }
+    /// Row r of the current level before its peaks, in as_next (null when no level reads it).
+    vec3<float>* row_before_peaks(std::size_t r) {
+        level_work& lw = levels_[level_];
+        return lw.as_next ? &lw.as_next->texel_ref(int(r) / lw.n, 0, int(r) % lw.n, 0) : nullptr;
     }
     const cubemap<float>* next_level_cube() const {
         const level_work& lw = levels_[level_];
@@ -321,27 +357,22 @@ private:
     /// The whole-row operations of the current row once its chunks are done.
     void finish_row() {
         level_work& lw = levels_[level_];
-        src_->row_finish(lw.conv, row_, lw.n, row_out(row_), next_level_cube(),
-                         lw.before_peaks.empty() ? nullptr : lw.before_peaks.data() + row_ * std::size_t(lw.n));
+        src_->row_finish(lw.conv, row_, lw.n, row_out(row_), next_level_cube(), row_before_peaks(row_));
     }
 
     void next_level() {
         row_ = 0;
         chunk_ = 0;
         tap_ = 0;
-        // The finished level as the coarse tail of the level before it in the plan.
-        if (level_ > 0 && levels_[level_ - 1].tail_roughness >= 0.0) {
-            const level_work& lw = levels_[level_];
-            levels_[level_].as_next =
-                detail::prefilter_tail_cube(lw.n, [&](int f, int x, int y) { return lw.before_peaks[cube_texel_index(f, x, y, lw.n)]; });
-        }
+        face_ = 0;
         if (++pos_ < order_.size()) {
             level_ = order_[pos_];
             return;
         }
-        // The finished chain becomes the result; the previous result's storage becomes the chain
-        // under construction of the next pass (no copy; a first pass leaves it to set_source).
-        back_->update_borders();
+        // The finished chain (every face's borders rebuilt) becomes the result; the previous
+        // result's storage becomes the chain under construction of the next pass (no copy; a
+        // first pass leaves it to set_source).
+        IBL_ASSERT(back_->borders_valid());
         if (result_) {
             std::swap(static_cast<cubemap<float>&>(*result_), *back_);
         } else {
@@ -362,11 +393,13 @@ private:
     std::vector<std::size_t> order_; ///< the levels in the order prefilter computes them
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
     std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
+    std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
     detail::lane_sums<16> sums16_{};    ///< the current chunk's sums (by its width)
     detail::lane_sums<8> sums8_{};
     detail::lane_sums<4> sums4_{};
     detail::lane_sums<1> sums1_{};
     std::vector<vec3<float>*> outs_;    ///< the rows of a call's whole rows in the chain under construction
+    std::vector<vec3<float>*> befores_; ///< and in as_next (or null)
     bool pass_done_ = false;
     std::optional<specular_chain> result_;
     std::optional<cubemap<float>> back_; ///< the chain under construction (rows written in place)

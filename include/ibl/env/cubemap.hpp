@@ -26,9 +26,12 @@
 // texels with the same weights exactly on the edge) and at the 8 corners (all three faces give
 // (a + b + c) / 3 there).
 //
-// Mutation. texel_ref()/set_texel()/fill() write the interior and mark the borders stale;
-// generate_mips() (rebuilds levels >= 1 from level 0) or update_borders() (keeps all levels) must
-// run before lookups, which assert this with IBL_ASSERT.
+// Mutation. texel_ref()/set_texel()/fill() write the interior and mark the borders of that level
+// stale; generate_mips() (rebuilds levels >= 1 from level 0) or update_borders() (keeps all
+// levels) must run before lookups, which assert this with IBL_ASSERT. update_borders(level, face)
+// rebuilds one face of one level (a time-sliced producer spreads the borders over calls): the
+// borders are valid again once every face of every written level has been rebuilt after its
+// last write.
 //
 // Lookups (dir need not be unit; the zero vector maps to the centre of face +X as cube_lookup
 // documents, and NaN/inf components to some texel of face +X, never out of bounds). Face
@@ -158,10 +161,12 @@ public:
     [[nodiscard]] const vec3<T>& texel(int face, int x, int y, int level = 0) const noexcept {
         return data_[index(face, x, y, level)];
     }
-    /// Writable texel; marks the borders stale (call generate_mips() or update_borders()).
+    /// Writable texel; marks the borders of its level stale (call generate_mips() or update_borders()).
     [[nodiscard]] vec3<T>& texel_ref(int face, int x, int y, int level = 0) noexcept {
+        const std::size_t i = index(face, x, y, level);
         borders_dirty_ = true;
-        return data_[index(face, x, y, level)];
+        levels_[std::size_t(level)].stale_faces = all_faces;
+        return data_[i];
     }
     void set_texel(int face, int x, int y, int level, const vec3<T>& v) noexcept { texel_ref(face, x, y, level) = v; }
 
@@ -176,6 +181,7 @@ public:
             for (int y = 0; y < n; ++y)
                 for (int x = 0; x < n; ++x) data_[index(f, x, y, level)] = vec3<T>(fn(f, x, y));
         borders_dirty_ = true;
+        levels_[std::size_t(level)].stale_faces = all_faces;
     }
 
     /// Exact solid angle (steradians) of texel (x, y) of a level (the same on every face).
@@ -247,8 +253,26 @@ public:
 
     /// Rebuilds the 1-texel borders of every face of every level from the interiors.
     void update_borders() {
-        for (int l = 0; l < levels(); ++l) build_borders(l);
+        for (int l = 0; l < levels(); ++l) {
+            for (int f = 0; f < 6; ++f) build_face_borders(l, f);
+            levels_[std::size_t(l)].stale_faces = 0;
+        }
         borders_dirty_ = false;
+    }
+
+    /// Rebuilds the borders of one face of one level from the interiors (its own and its four
+    /// neighbours'): update_borders() in 6 levels() pieces. Lookups are allowed again once every
+    /// face of every level written since the last rebuild has been rebuilt. Throws
+    /// std::invalid_argument unless 0 <= level < levels() and 0 <= face < 6.
+    void update_borders(int level, int face) {
+        if (level < 0 || level >= levels() || face < 0 || face >= 6)
+            throw std::invalid_argument("ibl::cubemap::update_borders: level " + std::to_string(level) + ", face " +
+                                        std::to_string(face) + " outside [0, " + std::to_string(levels()) + ") x [0, 6)");
+        build_face_borders(level, face);
+        levels_[std::size_t(level)].stale_faces &= std::uint8_t(~(1u << face));
+        bool stale = false;
+        for (const level_info& li : levels_) stale = stale || li.stale_faces != 0;
+        borders_dirty_ = stale;
     }
 
     /// Replaces non-finite components (and negative ones when zero_negative) of every texel of
@@ -275,7 +299,9 @@ private:
         std::size_t offset = 0;  ///< index of the first stored texel of face 0 (with border)
         T omega = T(0);          ///< average texel solid angle 4 pi / (6 n^2)
         T log2_omega = T(0);
+        std::uint8_t stale_faces = 0; ///< bit f: face f's borders predate a write to this level
     };
+    static constexpr std::uint8_t all_faces = 0x3f;
 
     static int min_int(int a, int b) noexcept { return a < b ? a : b; }
     /// Face and (s, t) clamped to [0, 1] (NaN -> 0: bad directions read a valid texel).
@@ -340,26 +366,25 @@ private:
         gy = min_int(int(c.t * dn), n - 1);
     }
 
-    void build_borders(int level) {
+    /// The borders of one face of a level: its edges from the neighbours' interiors, then its corners.
+    void build_face_borders(int level, int f) {
         const int n = size(level);
-        for (int f = 0; f < 6; ++f) {
-            for (int i = 0; i < n; ++i) {
-                const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
-                for (int e = 0; e < 4; ++e) {
-                    int g, gx, gy;
-                    fold_border(f, xs[e], ys[e], n, g, gx, gy);
-                    data_[index(f, xs[e], ys[e], level)] = data_[index(g, gx, gy, level)];
-                }
+        for (int i = 0; i < n; ++i) {
+            const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
+            for (int e = 0; e < 4; ++e) {
+                int g, gx, gy;
+                fold_border(f, xs[e], ys[e], n, g, gx, gy);
+                data_[index(f, xs[e], ys[e], level)] = data_[index(g, gx, gy, level)];
             }
-            const int cx[2] = {-1, n}, ix[2] = {0, n - 1};
-            for (int u = 0; u < 2; ++u)
-                for (int v = 0; v < 2; ++v) {
-                    const vec3<T> a = data_[index(f, ix[u], ix[v], level)];
-                    const vec3<T> b = data_[index(f, cx[u], ix[v], level)];
-                    const vec3<T> c = data_[index(f, ix[u], cx[v], level)];
-                    data_[index(f, cx[u], cx[v], level)] = a + ((b - a) + (c - a)) / T(3);
-                }
         }
+        const int cx[2] = {-1, n}, ix[2] = {0, n - 1};
+        for (int u = 0; u < 2; ++u)
+            for (int v = 0; v < 2; ++v) {
+                const vec3<T> a = data_[index(f, ix[u], ix[v], level)];
+                const vec3<T> b = data_[index(f, cx[u], ix[v], level)];
+                const vec3<T> c = data_[index(f, ix[u], cx[v], level)];
+                data_[index(f, cx[u], cx[v], level)] = a + ((b - a) + (c - a)) / T(3);
+            }
     }
 
     /// Level `level` from level - 1: per coarse texel, sum over overlap pieces of
