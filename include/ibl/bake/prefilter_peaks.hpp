@@ -404,10 +404,16 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
     }
     if (live.empty()) return;
     constexpr int W = peak_lanes;
+    const float inv = 1.f / float(n);
+    const float tc = 2.f * ((float(y) + 0.5f) * inv) - 1.f;
+    with_cube_face_point<float>(face, [&](auto point) {
     for (int x0 = 0; x0 < n; x0 += W) {
+        // the lanes' texel directions (cube_texel_direction with the face chosen once; lanes past
+        // the row's end repeat its last texel and are not written)
         float dx[W], dy[W], dz[W], ar[W], ag[W], ab[W];
         for (int k = 0; k < W; ++k) {
-            const vec3<float> d = x0 + k < n ? normalize(cube_texel_direction<float>(face, x0 + k, y, n)) : vec3<float>(0.f);
+            const float sc = 2.f * ((float(std::min(x0 + k, n - 1)) + 0.5f) * inv) - 1.f;
+            const vec3<float> d = normalize(point(sc, tc));
             dx[k] = d.x, dy[k] = d.y, dz[k] = d.z;
             ar[k] = ag[k] = ab[k] = 0.f;
         }
@@ -435,6 +441,7 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
         }
         for (int k = 0; k < W && x0 + k < n; ++k) out[x0 + k] += vec3<float>(ar[k], ag[k], ab[k]);
     }
+    });
 }
 
 } // namespace detail

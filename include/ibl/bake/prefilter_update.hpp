@@ -334,7 +334,7 @@ private:
         detail::lane_sums<W>& st = sums<W>();
         if (tap_ == 0) st = detail::lane_sums<W>{};
         detail::lane_frames<W> fr;
-        for (std::size_t k = 0; k < W; ++k) detail::load_lane_frame(fr, k, face, x0 + int(k), y, n);
+        detail::load_row_frames<W>(fr, face, x0, y, n);
         src_->lanes_part(lw.conv, fr, st, end);
     }
     /// Taps [tap_, end) of the current row's chunk at x0 of w lanes.

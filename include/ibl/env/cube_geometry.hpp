@@ -57,6 +57,31 @@ template <class T> IBL_FUNC vec3<T> cube_face_point(int face, T sc, T tc) noexce
     }
 }
 
+namespace detail {
+/// cube_face_point of a face fixed at compile time (the same components, no switch).
+template <int F, class T> IBL_FUNC vec3<T> cube_face_point_of(T sc, T tc) noexcept {
+    if constexpr (F == 0) return {T(1), -tc, -sc};
+    else if constexpr (F == 1) return {T(-1), -tc, sc};
+    else if constexpr (F == 2) return {sc, T(1), tc};
+    else if constexpr (F == 3) return {sc, T(-1), -tc};
+    else if constexpr (F == 4) return {sc, -tc, T(1)};
+    else return {-sc, -tc, T(-1)};
+}
+/// fn(point) with point(sc, tc) == cube_face_point(face, sc, tc) for that face (face outside
+/// [0, 5] reads as 5, as cube_face_point's default): the face is chosen once, so a loop over a
+/// row's texels inside fn has no switch and vectorises.
+template <class T, class Fn> IBL_FUNC_VOID void with_cube_face_point(int face, Fn&& fn) {
+    switch (face) {
+    case 0: fn([](T sc, T tc) { return cube_face_point_of<0, T>(sc, tc); }); break;
+    case 1: fn([](T sc, T tc) { return cube_face_point_of<1, T>(sc, tc); }); break;
+    case 2: fn([](T sc, T tc) { return cube_face_point_of<2, T>(sc, tc); }); break;
+    case 3: fn([](T sc, T tc) { return cube_face_point_of<3, T>(sc, tc); }); break;
+    case 4: fn([](T sc, T tc) { return cube_face_point_of<4, T>(sc, tc); }); break;
+    default: fn([](T sc, T tc) { return cube_face_point_of<5, T>(sc, tc); }); break;
+    }
+}
+} // namespace detail
+
 /// Unit direction through texture coordinates (s, t) in [0, 1] of a face.
 template <class T> IBL_FUNC vec3<T> cube_direction(int face, T s, T t) noexcept {
     return glm::normalize(cube_face_point(face, T(2) * s - T(1), T(2) * t - T(1)));
