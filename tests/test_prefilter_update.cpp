@@ -78,7 +78,7 @@ TEST_CASE("prefilter_update: any budget finishes with the one-shot chain, bit fo
         // a face's borders) until the next would exceed the budget, so it never exceeds
         // max(budget, the dearest unit), and every call but the last spends more than budget - U
         // (U the dearest unit)
-        std::uint64_t unit = 0;
+        std::uint64_t unit = up.setup_unit_taps(); // a packed row of the source, the split's patch
         for (std::size_t k = 0; k < up.plan().size(); ++k) unit = std::max(unit, up.unit_taps(k));
         CHECK(max_spent <= std::max(budget, unit));
         if (budget > unit) CHECK(std::uint64_t(calls) <= (total + budget - unit) / (budget - unit + 1) + 1);
@@ -96,7 +96,7 @@ TEST_CASE("prefilter_update: rows dearer than the budget are computed in pieces,
     const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::serial_executor{});
     for (std::uint64_t budget : {std::uint64_t(3000), std::uint64_t(4000)}) {
         ibl::prefilter_update<> up(src, o);
-        std::uint64_t unit = 0, dearest_row = 0;
+        std::uint64_t unit = up.setup_unit_taps(), dearest_row = 0;
         for (std::size_t k = 0; k < up.plan().size(); ++k) {
             unit = std::max(unit, up.unit_taps(k));
             dearest_row = std::max(dearest_row, up.row_taps(k));
@@ -158,6 +158,34 @@ TEST_CASE("prefilter_update: a source change restarts the pass; the last finishe
     up.set_source(s8);
     up.finish();
     CHECK(same_bits(*up.result(), ibl::prefilter(s8, o)));
+}
+
+TEST_CASE("prefilter_update: the fast filter's split and packing restart with each source, in budgeted units") {
+    // Sources with different peaks (a brighter diagonal), the packed copy's storage reused: every
+    // pass equals the one-shot chain, and the pass's first units (the packing) stay within the budget.
+    ibl::cubemap<float> a = sky(32, 1.0f), b = sky(32, 500.0f);
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    o.samples_per_level = {0, 8, 16, 32, 64};
+    o.levels = 5;
+    ibl::prefilter_update<> up(a, o);
+    int pass = 0;
+    for (const ibl::cubemap<float>* src : {&a, &b, &a, &b}) {
+        if (pass++ % 2 == 0) up.set_source(*src); // a copy
+        else up.set_source(ibl::cubemap<float>(*src)); // moved in
+        const std::uint64_t budget = 2 * up.setup_unit_taps();
+        std::uint64_t unit = up.setup_unit_taps(), first = 0;
+        for (std::size_t k = 0; k < up.plan().size(); ++k) unit = std::max(unit, up.unit_taps(k));
+        int calls = 0;
+        while (!up.done()) {
+            const std::uint64_t s = up.step(budget);
+            CHECK(s <= std::max(budget, unit));
+            if (calls++ == 0) first = s;
+            REQUIRE(calls < 1000000);
+        }
+        CHECK(first <= budget);
+        CHECK(same_bits(*up.result(), ibl::prefilter(*src, o, ibl::serial_executor{})));
+    }
 }
 
 TEST_CASE("prefilter_update: budget 0 does nothing; bad options throw as prefilter does") {

@@ -454,26 +454,53 @@ struct prefilter_cube_level {
 /// object serves prefilter and prefilter_update, so both compute a row by the same operations.
 template <class Lobe, class T> class prefilter_cube_source {
 public:
+    /// The source of a prefilter: the peak split (the fast filter's), then the packed copy.
     template <class Executor>
-    prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, Executor& ex) : opt_(opt), n0_(src.size(0)) {
+    prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, Executor& ex) : prefilter_cube_source(src, opt, ex, 0) {
+        ex(packed_rows(packed_), [&](std::size_t b, std::size_t e) { pack(src, b, e); });
+        finish_packing(src, ex);
+    }
+    /// The same with the packing left to the caller (prefilter_update spreads it over its calls):
+    /// pack() every item of pack_items(), then finish_packing(), then the object is the one the
+    /// other constructor builds (the same operations, so the same bits).
+    template <class Executor>
+    prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, Executor& ex, int /*deferred packing*/)
+        : opt_(opt) {
+        restart(src, ex);
+    }
+    /// Deferred packing of a new source: the peak split again, the packed copy's storage kept when
+    /// the source has the same levels (every packing item overwrites its texels).
+    template <class Executor> void restart(const cubemap<T>& src, Executor& ex) {
+        const bool same_layout = int(packed_.levels.size()) == src.levels() && n0_ == src.size(0) && !packed_.data.empty();
+        n0_ = src.size(0);
+        table_source_levels_ = src.levels();
+        peaks_.clear();
+        mean_ = threshold_ = 0.0;
         if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
-            if (opt.method == prefilter_method::fast && opt.peaks.enabled) {
-                cube_peak_split<T> split = find_cube_peaks(src, opt.peaks, ex);
+            if (opt_.method == prefilter_method::fast && opt_.peaks.enabled) {
+                cube_peak_split<T> split = find_cube_peaks(src, opt_.peaks, ex);
                 peaks_ = std::move(split.peaks);
                 mean_ = split.mean_luminance;
-                if (!peaks_.empty()) {
-                    table_source_levels_ = src.levels();
-                    if constexpr (std::is_same_v<T, float>) { // the base patched into the packed source
-                        packed_ = pack_cube(src, ex);
-                        if (patch_packed_peaks(packed_, src, peaks_, split.threshold)) return;
-                    }
-                    packed_ = pack_cube(split_cube_peaks(src, opt.peaks, ex).base, ex);
-                    return;
-                }
+                threshold_ = split.threshold;
             }
         }
-        packed_ = pack_cube(src, ex);
-        table_source_levels_ = src.levels();
+        if (!same_layout) packed_ = packed_layout(src);
+    }
+    /// Packing items (packed_rows), and items [b, e) copied from the source.
+    [[nodiscard]] std::size_t pack_items() const noexcept { return packed_rows(packed_); }
+    [[nodiscard]] const std::vector<packed_cube::level>& packed_levels() const noexcept { return packed_.levels; }
+    [[nodiscard]] std::size_t pack_item_texels(std::size_t item) const noexcept {
+        return std::size_t(packed_.levels[packed_row_level(packed_, item)].stride);
+    }
+    void pack(const cubemap<T>& src, std::size_t b, std::size_t e) noexcept { pack_cube_rows(packed_, src, b, e); }
+    /// After every item: the peaks taken out of the packed copy (the base of the split), in place
+    /// when the mips nest (patch_packed_peaks, a few texels per peak and level), else by packing
+    /// the split's base again (a chain whose mips do not halve).
+    template <class Executor> void finish_packing(const cubemap<T>& src, Executor& ex) {
+        if (peaks_.empty()) return;
+        if constexpr (std::is_same_v<T, float>)
+            if (patch_packed_peaks(packed_, src, peaks_, threshold_)) return;
+        packed_ = pack_cube(split_cube_peaks(src, opt_.peaks, ex).base, ex);
     }
     /// The taps of a plan level (tables from the source's lod mapping), its peaks and its coarse
     /// tail from the level of roughness next_roughness (< 0: none).
@@ -521,7 +548,7 @@ private:
     static double clamped(double r) noexcept { return std::clamp(std::isfinite(r) ? r : 0.0, 0.0, 1.0); }
     prefilter_options opt_;
     int n0_ = 1, table_source_levels_ = 1;
-    double mean_ = 0.0;
+    double mean_ = 0.0, threshold_ = 0.0;
     packed_cube packed_{};
     std::vector<cube_peak> peaks_;
 };

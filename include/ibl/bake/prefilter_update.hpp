@@ -47,11 +47,16 @@
 // nothing is copied when a level or a pass finishes: the faces' borders are work units, and the
 // finished chain is swapped with the previous result.
 //
-// Costs outside the budget: the constructor and set_source copy the source (kept for the mirror
-// level), pack it into the kernel's layout (passes over its texels) and allocate the chain under
-// construction and the as_next cubes (a first pass, or a source of another shape; later passes
-// reuse the storage of the result they replace). All are linear and small next to the convolution
-// (hundreds of taps per texel).
+// A pass starts with more units: the packed copy of the source that the taps read, a bordered row
+// of one of its levels per unit (ceil((n + 2) / 2) taps: two texels to a tap), then, with the fast
+// filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels).
+//
+// Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
+// copy of every texel, none when the source is moved in), runs the fast filter's peak split (a pass
+// over level 0's luminance) and, for a first pass or a source of another shape, plans the levels
+// and allocates the packed copy, the chain under construction and the as_next cubes (later passes
+// reuse the storage). Measured at 256^2 after a pass (cold caches): 0.9-1.6 ms with a copy, about
+// 0.01 ms moved in, plus 1.0 ms for the split (docs/ARCHITECTURE.md, "Dynamic probes").
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
 // prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
@@ -81,35 +86,25 @@ template <class Lobe = ggx_lobe>
     requires ld_lobe<Lobe>
 class prefilter_update {
 public:
-    /// Plans the pass of prefilter<Lobe>(source, opt) and starts it. Throws as prefilter.
-    explicit prefilter_update(const cubemap<float>& source, prefilter_options opt = {}) : opt_(std::move(opt)) {
-        set_source(source);
+    /// Plans the pass of prefilter<Lobe>(source, opt) and starts it (on its own copy of the source,
+    /// or on the source moved in). Throws as prefilter.
+    explicit prefilter_update(cubemap<float> source, prefilter_options opt = {}) : opt_(std::move(opt)) {
+        set_source(std::move(source));
     }
 
     /// Restarts the pass on a new source; result() keeps the last finished chain until the new
-    /// pass finishes. Throws as prefilter (a new size may exceed the limits).
+    /// pass finishes. Throws as prefilter (a new size may exceed the limits). The pass reads its
+    /// own copy of the source (the caller may change `source` at once): a copy of every texel of
+    /// every level; moving the source in (set_source(std::move(c))) saves it.
     void set_source(const cubemap<float>& source) {
         const bool same_shape = source_ && source_->size(0) == source.size(0) && source_->levels() == source.levels();
         source_ = source;
-        serial_executor ex;
-        src_.emplace(*source_, opt_, ex);
-        if (!same_shape) plan_levels();
-        else // the tables stay; the peaks of the fast filter's split belong to the source
-            for (std::size_t k = 0; k < levels_.size(); ++k)
-                if (!levels_[k].mirror) {
-                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
-                    set_convolved_costs(levels_[k]);
-                }
-        // The chain under construction (the rows are written into it; outside the budget).
-        if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
-            back_.emplace(first_size_, int(levels_.size()));
-        pos_ = 0;
-        level_ = order_.front();
-        row_ = 0;
-        chunk_ = 0;
-        tap_ = 0;
-        face_ = 0;
-        pass_done_ = false;
+        restart(same_shape);
+    }
+    void set_source(cubemap<float>&& source) {
+        const bool same_shape = source_ && source_->size(0) == source.size(0) && source_->levels() == source.levels();
+        source_ = std::move(source);
+        restart(same_shape);
     }
 
     /// Computes work units (header comment) until the next would exceed `budget` taps (at least
@@ -121,6 +116,22 @@ public:
         std::uint64_t spent = 0;
         bool stop = false;
         while (!pass_done_ && !stop && spent < budget) {
+            if (!packed_) { // the pass's first units: the packed copy of the source, then the split's patch
+                if (pack_item_ < src_->pack_items()) {
+                    const std::uint64_t c = pack_item_taps(pack_item_);
+                    if (spent > 0 && c > budget - spent) break;
+                    src_->pack(*source_, pack_item_, pack_item_ + 1);
+                    ++pack_item_;
+                    spent += c;
+                    continue;
+                }
+                if (spent > 0 && patch_taps() > budget - spent) break;
+                serial_executor one;
+                src_->finish_packing(*source_, one);
+                packed_ = true;
+                spent += patch_taps();
+                continue;
+            }
             const level_work& lw = levels_[level_];
             const std::size_t rows_total = std::size_t(6 * lw.n);
             if (row_ == rows_total) { // the finished level's borders, a face per unit
@@ -193,12 +204,17 @@ public:
     const std::optional<specular_chain>& result() const noexcept { return result_; }
     /// Taps of a whole pass, and those still to compute in the current one.
     std::uint64_t total_taps() const noexcept {
-        std::uint64_t t = 0;
+        std::uint64_t t = setup_taps(0) + patch_taps();
         for (const level_work& lw : levels_) t += level_taps(lw);
         return t;
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
+        if (!packed_) {
+            std::uint64_t t = setup_taps(pack_item_) + patch_taps();
+            for (const level_work& w : levels_) t += level_taps(w);
+            return t;
+        }
         const level_work& lw = levels_[level_];
         std::uint64_t t = std::uint64_t(6 - face_) * lw.border_taps;
         if (row_ < std::size_t(6 * lw.n)) {
@@ -216,12 +232,41 @@ public:
     /// call within the budget.
     int level_size(std::size_t k) const noexcept { return levels_[k].n; }
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
+    /// The dearest of a pass's first units (a packed row of the source, the split's patch).
+    std::uint64_t setup_unit_taps() const noexcept { return std::max(pack_item_taps(0), patch_taps()); }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
         return std::max(lw.border_taps, lw.mirror ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
     }
 
 private:
+    /// The new pass on source_ (set_source).
+    void restart(bool same_shape) {
+        serial_executor ex;
+        // The peak split now; the packing in the pass's first units (into the same storage when
+        // the shape is unchanged).
+        if (src_) src_->restart(*source_, ex);
+        else src_.emplace(*source_, opt_, ex, 0);
+        pack_item_ = 0;
+        packed_ = false;
+        if (!same_shape) plan_levels();
+        else // the tables stay; the peaks of the fast filter's split belong to the source
+            for (std::size_t k = 0; k < levels_.size(); ++k)
+                if (!levels_[k].mirror) {
+                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
+                    set_convolved_costs(levels_[k]);
+                }
+        // The chain under construction (the rows are written into it; outside the budget).
+        if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
+            back_.emplace(first_size_, int(levels_.size()));
+        pos_ = 0;
+        level_ = order_.front();
+        row_ = 0;
+        chunk_ = 0;
+        tap_ = 0;
+        face_ = 0;
+        pass_done_ = false;
+    }
     /// Peak evaluations counted as one tap in the budget (bake/prefilter_peaks.hpp: about ten
     /// vectorised float operations against a bilinear tap's rotation, face selection and reads).
     static constexpr std::size_t peak_per_tap = 8;
@@ -229,6 +274,24 @@ private:
     /// texel along a column, against a tap's 8-12 texel reads and its arithmetic; measured by
     /// bench/bench_prefilter.cpp, BM_prefilter_update_step).
     static constexpr std::size_t border_per_tap = 2;
+    /// Packed texels counted as one tap (a copy with a finiteness test per component).
+    static constexpr std::size_t pack_per_tap = 2;
+    std::uint64_t pack_item_taps(std::size_t item) const noexcept {
+        return (std::uint64_t(src_->pack_item_texels(item)) + pack_per_tap - 1) / pack_per_tap;
+    }
+    /// The packing items from `item` on (a level's items are its bordered rows, of equal cost).
+    std::uint64_t setup_taps(std::size_t item) const noexcept {
+        std::uint64_t t = 0;
+        std::size_t first = 0;
+        for (const detail::packed_cube::level& li : src_->packed_levels()) {
+            const std::size_t end = first + std::size_t(6 * li.stride);
+            if (end > item) t += std::uint64_t(end - std::max(first, item)) * ((std::uint64_t(li.stride) + pack_per_tap - 1) / pack_per_tap);
+            first = end;
+        }
+        return t;
+    }
+    /// The split's patch: a few texels per peak and level of the packed copy.
+    std::uint64_t patch_taps() const noexcept { return 1 + std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
     struct level_work {
         int n = 1;
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
@@ -394,6 +457,8 @@ private:
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
     std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
     std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
+    std::size_t pack_item_ = 0;         ///< the next packing item of the pass's first units
+    bool packed_ = false;               ///< the packed copy (and its patch) done
     detail::lane_sums<16> sums16_{};    ///< the current chunk's sums (by its width)
     detail::lane_sums<8> sums8_{};
     detail::lane_sums<4> sums4_{};

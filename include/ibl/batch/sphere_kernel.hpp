@@ -66,10 +66,8 @@ struct packed_cube {
     std::vector<float> data; ///< 4 floats per texel: R, G, B, 1
 };
 
-/// The packed copy of c; the face rows of every level are copied through the executor (a plain
-/// copy: the result does not depend on it).
-template <class T, class Executor = serial_executor> packed_cube pack_cube(const cubemap<T>& c, Executor&& ex = Executor{}) {
-    IBL_ASSERT(c.borders_valid());
+/// The layout of c's packed copy: its levels and storage (texels 0); pack_cube_rows fills it.
+template <class T> packed_cube packed_layout(const cubemap<T>& c) {
     packed_cube p;
     std::size_t total = 0;
     for (int l = 0; l < c.levels(); ++l) {
@@ -83,24 +81,48 @@ template <class T, class Executor = serial_executor> packed_cube pack_cube(const
         p.levels.push_back(li);
     }
     p.data.assign(4 * total, 0.f);
-    // Work items: the bordered rows (n + 2 per face) of every face of every level, in order.
-    std::vector<std::size_t> first(p.levels.size() + 1, 0);
-    for (std::size_t l = 0; l < p.levels.size(); ++l) first[l + 1] = first[l] + std::size_t(6 * p.levels[l].stride);
-    ex(first.back(), [&](std::size_t b, std::size_t e) {
-        std::size_t l = 0;
-        for (std::size_t item = b; item < e; ++item) {
-            while (item >= first[l + 1]) ++l;
-            const packed_cube::level& li = p.levels[l];
-            const int f = int((item - first[l]) / std::size_t(li.stride)), y = int((item - first[l]) % std::size_t(li.stride)) - 1;
-            float* q = p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
-                                            std::size_t(y + 1) * std::size_t(li.stride));
-            for (int x = -1; x <= li.n; ++x, q += 4) {
-                const vec3<T>& v = c.texel(f, x, y, int(l));
-                for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
-                q[3] = 1.f;
-            }
+    return p;
+}
+/// The work items of packing: the bordered rows (n + 2 per face) of every face of every level, in order.
+inline std::size_t packed_rows(const packed_cube& p) noexcept {
+    std::size_t rows = 0;
+    for (const packed_cube::level& li : p.levels) rows += std::size_t(6 * li.stride);
+    return rows;
+}
+/// The level of packing item `item` (item < packed_rows(p)).
+inline std::size_t packed_row_level(const packed_cube& p, std::size_t item) noexcept {
+    std::size_t l = 0;
+    for (std::size_t first = 0; l + 1 < p.levels.size(); ++l) {
+        const std::size_t rows = std::size_t(6 * p.levels[l].stride);
+        if (item < first + rows) break;
+        first += rows;
+    }
+    return l;
+}
+/// Copies packing items [b, e) of c into p (packed_layout(c)): non-finite components as 0, the
+/// fourth channel 1. The items are independent: any partition gives the same copy.
+template <class T> void pack_cube_rows(packed_cube& p, const cubemap<T>& c, std::size_t b, std::size_t e) noexcept {
+    std::size_t l = 0, first = 0;
+    for (std::size_t item = b; item < e; ++item) {
+        while (item >= first + std::size_t(6 * p.levels[l].stride)) first += std::size_t(6 * p.levels[l++].stride);
+        const packed_cube::level& li = p.levels[l];
+        const int f = int((item - first) / std::size_t(li.stride)), y = int((item - first) % std::size_t(li.stride)) - 1;
+        float* q = p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
+                                        std::size_t(y + 1) * std::size_t(li.stride));
+        for (int x = -1; x <= li.n; ++x, q += 4) {
+            const vec3<T>& v = c.texel(f, x, y, int(l));
+            for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
+            q[3] = 1.f;
         }
-    });
+    }
+}
+
+/// The packed copy of c; the face rows of every level are copied through the executor (a plain
+/// copy: the result does not depend on it).
+template <class T, class Executor = serial_executor> packed_cube pack_cube(const cubemap<T>& c, Executor&& ex = Executor{}) {
+    IBL_ASSERT(c.borders_valid());
+    packed_cube p = packed_layout(c);
+    ex(packed_rows(p), [&](std::size_t b, std::size_t e) { pack_cube_rows(p, c, b, e); });
     return p;
 }
 
