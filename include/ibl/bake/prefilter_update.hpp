@@ -48,7 +48,7 @@
 // finished chain is swapped with the previous result.
 //
 // A pass starts with more units: the packed copy of the source that the taps read, a bordered row
-// of one of its levels per unit (ceil((n + 2) / 2) taps: two texels to a tap), then, with the fast
+// of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
 // filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels).
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
@@ -274,8 +274,10 @@ private:
     /// texel along a column, against a tap's 8-12 texel reads and its arithmetic; measured by
     /// bench/bench_prefilter.cpp, BM_prefilter_update_step).
     static constexpr std::size_t border_per_tap = 2;
-    /// Packed texels counted as one tap (a copy with a finiteness test per component).
-    static constexpr std::size_t pack_per_tap = 2;
+    /// Packed texels counted as one tap: a read of the source's texel, a finiteness test per
+    /// component and a 16-byte store, measured at about a tap's time (2-4 ns against 2.7-3 ns:
+    /// cold source memory after a pass) by a stand-alone run of whole passes.
+    static constexpr std::size_t pack_per_tap = 1;
     std::uint64_t pack_item_taps(std::size_t item) const noexcept {
         return (std::uint64_t(src_->pack_item_texels(item)) + pack_per_tap - 1) / pack_per_tap;
     }
