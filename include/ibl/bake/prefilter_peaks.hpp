@@ -49,6 +49,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <tuple>
 #include <vector>
@@ -154,31 +155,49 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
         s.mean_luminance = acc / four_pi_v<double>;
     }
     double t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * s.mean_luminance : 0.0;
+    // double(l) > t for a float l (>= 0, finite) is l >= above_t, the least float above t, so the
+    // scans compare floats (they vectorise).
+    auto least_float_above = [](double v) {
+        if (!(v < double(std::numeric_limits<float>::max()))) return std::numeric_limits<float>::infinity();
+        float f = float(v);
+        while (!(double(f) > v)) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+        return f;
+    };
+    float above_t = least_float_above(t);
     std::size_t above = 0;
-    for (float l : lum) above += double(l) > t ? 1 : 0;
+    for (const float l : lum) above += l >= above_t ? 1 : 0;
     if (above > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
         std::vector<float> sorted(lum);
         const std::size_t k = count - 1 - std::size_t(opt.max_peaks);
         std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
         t = std::max(t, double(sorted[k]));
+        above_t = least_float_above(t);
     }
     s.threshold = t;
     if (!(t > 0.0)) return s;
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) {
-                const float l = lum[cube_texel_index(f, x, y, n)];
-                if (!(double(l) > t)) continue;
-                const vec3<double> v(src.texel(f, x, y, 0));
-                const double om = cube_texel_solid_angle<double>(x, y, n);
-                cube_peak p;
-                p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
-                p.energy = v * ((1.0 - t / double(l)) * om);
-                p.weight = (double(l) - t) * om;
-                p.luminance = l;
-                p.face = f, p.x = x, p.y = y;
-                s.peaks.push_back(p);
-            }
+    std::vector<std::size_t> hits; // the texels above t, in cube_texel_index order (face, row, column)
+    for (std::size_t b = 0; b < count; b += 64) { // blocks with no texel above are skipped at once
+        const std::size_t e = std::min(count, b + 64);
+        int in_block = 0;
+        for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
+        if (in_block > 0)
+            for (std::size_t i = b; i < e; ++i)
+                if (lum[i] >= above_t) hits.push_back(i);
+    }
+    const std::size_t nn = std::size_t(n) * std::size_t(n);
+    for (const std::size_t i : hits) {
+        const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
+        const float l = lum[i];
+        const vec3<double> v(src.texel(f, x, y, 0));
+        const double om = cube_texel_solid_angle<double>(x, y, n);
+        cube_peak p;
+        p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
+        p.energy = v * ((1.0 - t / double(l)) * om);
+        p.weight = (double(l) - t) * om;
+        p.luminance = l;
+        p.face = f, p.x = x, p.y = y;
+        s.peaks.push_back(p);
+    }
     return s;
 }
 } // namespace detail

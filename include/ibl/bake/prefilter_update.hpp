@@ -56,7 +56,7 @@
 // over level 0's luminance) and, for a first pass or a source of another shape, plans the levels
 // and allocates the packed copy, the chain under construction and the as_next cubes (later passes
 // reuse the storage). Measured at 256^2 after a pass (cold caches): 0.9-1.6 ms with a copy, about
-// 0.01 ms moved in, plus 1.0 ms for the split (docs/ARCHITECTURE.md, "Dynamic probes").
+// 0.01 ms moved in, plus about 0.4-0.9 ms for the split (docs/ARCHITECTURE.md, "Dynamic probes").
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
 // prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
