@@ -247,7 +247,7 @@ template <std::size_t W> void convolve_level(const ibl::detail::packed_cube& src
         const int face = row / n, y = row % n;
         for (int x = 0; x < n; x += int(W)) {
             ibl::detail::lane_frames<W> fr;
-            for (std::size_t k = 0; k < W; ++k) ibl::detail::load_lane_frame(fr, k, face, x + int(k), y, n);
+            ibl::detail::load_row_frames<W>(fr, face, x, y, n);
             ibl::detail::convolve_lanes<W>(src, taps, fr, out.data() + std::size_t(row) * std::size_t(n) + std::size_t(x));
         }
     }
@@ -310,8 +310,7 @@ void BM_fixed_call_spread(benchmark::State& state) {
         for (std::uint64_t i = 0; i < chunks; ++i, ++next) {
             const int chunk = int(next % std::uint64_t(6 * n * chunks_per_row)), row = chunk / chunks_per_row;
             ibl::detail::lane_frames<16> fr;
-            for (std::size_t k = 0; k < 16; ++k)
-                ibl::detail::load_lane_frame(fr, k, row / n, (chunk % chunks_per_row) * 16 + int(k), row % n, n);
+            ibl::detail::load_row_frames<16>(fr, row / n, (chunk % chunks_per_row) * 16, row % n, n);
             ibl::detail::convolve_lanes<16>(c->src, c->taps, fr, out.data());
             benchmark::DoNotOptimize(out.data());
         }
