@@ -118,8 +118,8 @@ void BM_prefilter_fis(benchmark::State& state) { run_sweep(state, ibl::prefilter
 /// nearest-level reads as the FIS sweep: the error-vs-time frontier of the two side by side.
 void BM_prefilter_fast(benchmark::State& state) { run_sweep(state, ibl::prefilter_method::fast); }
 
-/// The fast filter with and without its peak split (bake/prefilter_peaks.hpp) and its coarse tail
-/// (prefilter_options::coarse_tail), nearest reads, range(1) samples at level 1 doubled per level
+/// The fast filter's tap sets on every level (sh_rough off) with and without its peak split
+/// (bake/prefilter_peaks.hpp) and its coarse tail (prefilter_options::coarse_tail), nearest reads, range(1) samples at level 1 doubled per level
 /// (the default schedule's shape), at face size range(3) (256 or 128): the real-time end of the
 /// frontier. args: env, spp, peaks, size, tail.
 void BM_prefilter_fast_split(benchmark::State& state) {
@@ -129,6 +129,19 @@ void BM_prefilter_fast_split(benchmark::State& state) {
     for (int l = 0; l < levels; ++l) o.samples_per_level.push_back(std::uint32_t(state.range(1)) << (l > 0 ? l - 1 : 0));
     o.peaks.enabled = state.range(2) != 0;
     o.coarse_tail = state.range(4) != 0;
+    o.sh_rough.enabled = false; // the tap sets on every level (BM_prefilter_fast_sh: the rough levels by SH)
+    run_chain(state, o, int(state.range(0)), int(state.range(3)));
+}
+
+/// The fast filter's default (equal-cost schedule from range(1) samples, peak split, coarse tail)
+/// with and without its rough levels by spherical harmonics (range(2); bake/prefilter_sh.hpp), at
+/// face size range(3). args: env, spp, sh, size.
+void BM_prefilter_fast_sh(benchmark::State& state) {
+    ibl::prefilter_options o;
+    o.levels = levels;
+    o.method = ibl::prefilter_method::fast;
+    for (int l = 0; l < levels; ++l) o.samples_per_level.push_back(ibl::equal_cost_prefilter_samples(std::uint32_t(state.range(1)), l));
+    o.sh_rough.enabled = state.range(2) != 0;
     run_chain(state, o, int(state.range(0)), int(state.range(3)));
 }
 
@@ -437,6 +450,11 @@ BENCHMARK(BM_prefilter_fast_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(bench
 BENCHMARK(BM_prefilter_fast_split)
     ->ArgNames({"env", "spp", "peaks", "size", "tail"})
     ->ArgsProduct({{1}, {4, 8, 16, 32, 64}, {0, 1}, {128, 256}, {0, 1}})
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_prefilter_fast_sh)
+    ->ArgNames({"env", "spp", "sh", "size"})
+    ->ArgsProduct({{1}, {16, 32, 64}, {0, 1}, {128, 256}})
     ->Unit(benchmark::kMillisecond)
     ->UseRealTime();
 BENCHMARK(BM_prefilter_is)

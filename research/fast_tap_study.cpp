@@ -182,6 +182,7 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
         o.weight = w;
         o.peaks.enabled = d.peaks;
         o.coarse_tail = d.reuse;
+        o.sh_rough.enabled = false; // the tap sets on every level (sh_rough_study measures the rough levels by SH)
         const ibl::specular_chain ch = ibl::prefilter(cube, o, ex);
         for (int l = 1; l < chain_levels; ++l) {
             const int n = ch.size(l);

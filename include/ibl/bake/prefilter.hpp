@@ -108,6 +108,7 @@
 #include "../runtime/roughness_mip.hpp"
 #include "prefilter_fast.hpp"
 #include "prefilter_peaks.hpp"
+#include "prefilter_sh.hpp"
 #include "sphere_convolve.hpp"
 
 namespace ibl {
@@ -169,6 +170,11 @@ struct prefilter_options {
     /// bilinear read per texel; the levels are filtered coarse to fine) and spends its tap set on
     /// the rest. Read by method = fast only; false filters every level from the source alone.
     bool coarse_tail = true;
+    /// The fast filter's rough levels by spherical-harmonic convolution (bake/prefilter_sh.hpp):
+    /// read by method = fast on a cubemap source; a level whose kernel needs at most
+    /// sh_rough.max_bands bands is reconstructed from the source's projection instead of its tap
+    /// set (and reads no coarse tail).
+    sh_rough_options sh_rough{};
 };
 
 /// Ceiling of the doubling sample schedule (samples per texel).
@@ -412,20 +418,31 @@ inline constexpr int prefilter_coarse_tail_min_face = 16;
 /// The roughness of the level after plan level k that level k reads its coarse tail from
 /// (prefilter_options::coarse_tail: the fast filter, a convolved level with a next level of face
 /// >= prefilter_coarse_tail_min_face; output level 0 has face first_size), or -1.
+/// The bands of plan level lp when the fast filter reconstructs it from the source's spherical
+/// harmonics (prefilter_options::sh_rough, bake/prefilter_sh.hpp; cubemap sources), else 0.
+template <class Lobe> int prefilter_sh_bands(const prefilter_options& opt, const prefilter_level& lp) {
+    if (opt.method != prefilter_method::fast || !opt.sh_rough.enabled) return 0;
+    if (lobe_mirror_limit<Lobe>() && lp.level == 0) return 0;
+    return sh_rough_bands<Lobe>(std::clamp(std::isfinite(lp.roughness) ? lp.roughness : 0.0, 0.0, 1.0), opt.weight, opt.sh_rough);
+}
+/// cube_source: the levels of a cubemap source, where a level by spherical harmonics reads no tail.
 template <class Lobe> double prefilter_tail_roughness(const prefilter_options& opt, const std::vector<prefilter_level>& plan,
-                                                      std::size_t k, int first_size) {
+                                                      std::size_t k, int first_size, bool cube_source = false) {
     if (opt.method != prefilter_method::fast || !opt.coarse_tail || k + 1 >= plan.size()) return -1.0;
     if (lobe_mirror_limit<Lobe>() && plan[k].level == 0) return -1.0;
+    if (cube_source && prefilter_sh_bands<Lobe>(opt, plan[k]) > 0) return -1.0;
     if (k + 1 >= 31 || (first_size >> (k + 1)) < prefilter_coarse_tail_min_face) return -1.0;
     return std::clamp(std::isfinite(plan[k + 1].roughness) ? plan[k + 1].roughness : 0.0, 0.0, 1.0);
 }
 /// The order prefilter computes the plan's levels in: coarse to fine when a level reads its
 /// coarse tail, else fine to coarse.
 template <class Lobe>
-std::vector<std::size_t> prefilter_order(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int first_size) {
+std::vector<std::size_t> prefilter_order(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int first_size,
+                                         bool cube_source = false) {
     std::vector<std::size_t> order(plan.size());
     bool tail = false;
-    for (std::size_t k = 0; k < plan.size(); ++k) tail = tail || prefilter_tail_roughness<Lobe>(opt, plan, k, first_size) >= 0.0;
+    for (std::size_t k = 0; k < plan.size(); ++k)
+        tail = tail || prefilter_tail_roughness<Lobe>(opt, plan, k, first_size, cube_source) >= 0.0;
     for (std::size_t k = 0; k < plan.size(); ++k) order[k] = tail ? plan.size() - 1 - k : k;
     return order;
 }
@@ -448,6 +465,7 @@ struct prefilter_cube_level {
     tap_table taps{};
     peak_level peaks{};
     float tail_share = 0.f; ///< > 0: the row adds this times the next level (prefilter_options::coarse_tail)
+    sh_level sh{};          ///< active: the level is reconstructed from the source's projection (no taps)
 };
 /// What prefilter reads from a cubemap source: the packed copy of the source (or of the base of
 /// its peak split), the split's peaks, and per level the taps and the merged peaks. The same
@@ -485,6 +503,45 @@ public:
             }
         }
         if (!same_layout) packed_ = packed_layout(src);
+        sh_ready_ = false;
+        proj_.clear();
+    }
+    /// The spherical-harmonic projection for levels of up to `bands` bands (0: none), after the
+    /// packing: sh_add_row every row of sh_rows() (a face's rows in order), then sh_finish().
+    void sh_setup(int bands) {
+        sh_ready_ = false;
+        if (bands <= 0) {
+            proj_ = sh_projection{};
+            return;
+        }
+        const int pl = sh_projection_level(packed_, bands);
+        if (proj_.bands() != bands || proj_.level() != pl || proj_.face_size() != packed_.levels[std::size_t(pl)].n)
+            proj_ = sh_projection(bands, pl, packed_.levels[std::size_t(pl)].n);
+        else
+            proj_.clear();
+    }
+    [[nodiscard]] std::size_t sh_rows() const noexcept { return proj_.bands() > 0 ? proj_.rows() : 0; }
+    [[nodiscard]] int sh_projection_bands() const noexcept { return proj_.bands(); }
+    [[nodiscard]] int sh_projection_face() const noexcept { return proj_.face_size(); }
+    void sh_add_row(std::size_t row) noexcept { proj_.add_row(packed_, row); }
+    void sh_finish() {
+        sh_coef_ = proj_.coefficients();
+        sh_ready_ = true;
+    }
+    /// The projection (every face's rows in order, the faces in parallel) and its coefficients.
+    template <class Executor> void sh_project(int bands, Executor& ex) {
+        sh_setup(bands);
+        if (bands <= 0) return;
+        const std::size_t n = std::size_t(proj_.face_size());
+        ex(6, [&](std::size_t b, std::size_t e) {
+            for (std::size_t f = b; f < e; ++f)
+                for (std::size_t y = 0; y < n; ++y) sh_add_row(f * n + y);
+        });
+        sh_finish();
+    }
+    /// A level by spherical harmonics gets the coefficients of the current source's projection.
+    void sh_fill(prefilter_cube_level& lv) const {
+        if (lv.sh.active() && sh_ready_) lv.sh.set_coefficients(sh_coef_, proj_.bands());
     }
     /// Packing items (packed_rows), and items [b, e) copied from the source.
     [[nodiscard]] std::size_t pack_items() const noexcept { return packed_rows(packed_); }
@@ -504,13 +561,24 @@ public:
     }
     /// The taps of a plan level (tables from the source's lod mapping), its peaks and its coarse
     /// tail from the level of roughness next_roughness (< 0: none).
-    template <class Env> prefilter_cube_level level(const Env& env, const prefilter_level& lp, double next_roughness = -1.0) const {
+    /// n: the level's face size. A level by spherical harmonics needs sh_setup first.
+    template <class Env>
+    prefilter_cube_level level(const Env& env, const prefilter_level& lp, double next_roughness, int n) const {
         prefilter_cube_level lv;
+        lv.peaks = level_peaks(lp);
+        if (const int bands = prefilter_sh_bands<Lobe>(opt_, lp); bands > 0 && proj_.bands() >= bands) {
+            lv.sh.bands = bands;
+            lv.sh.rec = sh_recurrence(bands);
+            const std::vector<double>& k = *lobe_band_factors<Lobe>(clamped(lp.roughness), opt_.weight);
+            lv.sh.k.assign(k.begin(), k.begin() + bands);
+            lv.sh.norm = sh_level_norm_for<Lobe>(lv.sh, clamped(lp.roughness), opt_.weight, proj_, n);
+            sh_fill(lv);
+            return lv;
+        }
         sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(env, lp.roughness, lp.samples, opt_.method,
                                                                           opt_.lod_bias, opt_.weight, next_roughness);
         table.trilinear = lp.trilinear;
         lv.taps = make_taps(table, int(packed_.levels.size()));
-        lv.peaks = level_peaks(lp);
         if (next_roughness >= 0.0) lv.tail_share = float(fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).share);
         return lv;
     }
@@ -525,7 +593,8 @@ public:
     /// receives the row before its peaks: this level as the coarse tail of the level before it reads it.
     void row(const prefilter_cube_level& lv, std::size_t row, int n, vec3<float>* out, const cubemap<float>* next = nullptr,
              vec3<float>* base_out = nullptr) const {
-        convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
+        if (lv.sh.active()) sh_level_row(lv.sh, int(row) / n, int(row) % n, n, out);
+        else convolve_row(packed_, lv.taps, int(row) / n, int(row) % n, n, out);
         row_finish(lv, row, n, out, next, base_out);
     }
     /// Taps [st.next, end) of W lanes of a level (their frames fr): a row's tap sums below a texel
@@ -551,7 +620,16 @@ private:
     double mean_ = 0.0, threshold_ = 0.0;
     packed_cube packed_{};
     std::vector<cube_peak> peaks_;
+    sh_projection proj_{};
+    std::vector<double> sh_coef_;
+    bool sh_ready_ = false;
 };
+/// The most bands of the plan's levels by spherical harmonics (0: none).
+template <class Lobe> int prefilter_sh_max_bands(const prefilter_options& opt, const std::vector<prefilter_level>& plan) {
+    int b = 0;
+    for (const prefilter_level& lp : plan) b = std::max(b, prefilter_sh_bands<Lobe>(opt, lp));
+    return b;
+}
 } // namespace detail
 
 /// The prefiltered mip chain of an environment for lobe L (a specular_chain: the levels and the
@@ -574,11 +652,13 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     detail::check_prefilter_work(opt, plan, base);
     cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()));
     // Coarse to fine when a level reads its coarse tail from the next (finished) level.
-    const std::vector<std::size_t> order = detail::prefilter_order<Lobe>(opt, plan, out.size(0));
     std::optional<cubemap<float>> next; // the level after the one being computed, as its tail reads it
     if constexpr (requires { detail::pack_cube(env); }) {
-        // Cubemap sources: one packed copy for every level, the peak split of the fast filter.
-        const detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, ex);
+        const std::vector<std::size_t> order = detail::prefilter_order<Lobe>(opt, plan, out.size(0), true);
+        // Cubemap sources: one packed copy for every level, the peak split of the fast filter,
+        // the projection of the levels by spherical harmonics.
+        detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, ex);
+        cs.sh_project(detail::prefilter_sh_max_bands<Lobe>(opt, plan), ex);
         for (const std::size_t k : order) {
             const prefilter_level& lp = plan[k];
             const int n = out.size(int(k));
@@ -591,13 +671,13 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                     for (std::size_t row = b; row < e; ++row) detail::prefilter_base_row(env, n, m, row, rows[row]);
                 });
             } else {
-                const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0));
-                const detail::prefilter_cube_level lv = cs.level(env, lp, rn);
+                const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0), true);
+                const detail::prefilter_cube_level lv = cs.level(env, lp, rn, n);
                 const cubemap<float>* nx = rn >= 0.0 && next ? &*next : nullptr;
                 // The level before this one reads its coarse tail from this level without its peaks
                 // (they are added to every level exactly, through its own kernel).
                 std::vector<vec3<float>> base;
-                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0)) >= 0.0)
+                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0)
                     base.resize(std::size_t(6) * std::size_t(n) * std::size_t(n));
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
                     for (std::size_t row = b; row < e; ++row)
@@ -608,6 +688,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
             }
         }
     } else {
+        const std::vector<std::size_t> order = detail::prefilter_order<Lobe>(opt, plan, out.size(0));
         for (const std::size_t k : order) {
             const prefilter_level& lp = plan[k];
             const int n = out.size(int(k));

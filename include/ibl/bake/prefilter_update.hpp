@@ -49,7 +49,12 @@
 //
 // A pass starts with more units: the packed copy of the source that the taps read, a bordered row
 // of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
-// filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels).
+// filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels),
+// then, when the fast filter reconstructs rough levels from spherical harmonics
+// (bake/prefilter_sh.hpp), the projection of the packed source, a row of its level per unit
+// (1 + ceil(m B^2 / 16) taps for m texels and B bands; the last row also reduces the sums). A
+// level by spherical harmonics is computed in whole rows, n_l ceil(B_l^2 / 32) taps plus the
+// row's peaks (as its finish), like a mirror level's rows.
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
 // copy of every texel, none when the source is moved in), runs the fast filter's peak split (a pass
@@ -132,6 +137,16 @@ public:
                 spent += patch_taps();
                 continue;
             }
+            if (sh_row_ < src_->sh_rows()) { // the projection of the levels by spherical harmonics, a row per unit
+                if (spent > 0 && sh_row_taps() > budget - spent) break;
+                src_->sh_add_row(sh_row_);
+                spent += sh_row_taps();
+                if (++sh_row_ == src_->sh_rows()) { // its last row also reduces the sums
+                    src_->sh_finish();
+                    for (level_work& w : levels_) src_->sh_fill(w.conv);
+                }
+                continue;
+            }
             const level_work& lw = levels_[level_];
             const std::size_t rows_total = std::size_t(6 * lw.n);
             if (row_ == rows_total) { // the finished level's borders, a face per unit
@@ -144,14 +159,14 @@ public:
             }
             if (chunk_ == 0 && tap_ == 0) { // at the start of a row: whole rows, in parallel
                 std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
-                if (lw.mirror && rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
+                if (lw.whole_rows() && rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
                 if (rows > 0) {
                     run_rows(row_, row_ + rows, ex);
                     spent += rows * lw.taps_per_row;
                     row_ += rows;
                     continue;
                 }
-                if (lw.mirror) break;
+                if (lw.whole_rows()) break;
             }
             // A row that does not fit: its chunks of lanes, and the taps of a chunk, while they fit.
             const std::uint64_t count = lw.conv.taps.w.size();
@@ -204,22 +219,23 @@ public:
     const std::optional<specular_chain>& result() const noexcept { return result_; }
     /// Taps of a whole pass, and those still to compute in the current one.
     std::uint64_t total_taps() const noexcept {
-        std::uint64_t t = setup_taps(0) + patch_taps();
+        std::uint64_t t = setup_taps(0) + patch_taps() + std::uint64_t(src_->sh_rows()) * sh_row_taps();
         for (const level_work& lw : levels_) t += level_taps(lw);
         return t;
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
+        const std::uint64_t sh = std::uint64_t(src_->sh_rows() - sh_row_) * sh_row_taps();
         if (!packed_) {
-            std::uint64_t t = setup_taps(pack_item_) + patch_taps();
+            std::uint64_t t = setup_taps(pack_item_) + patch_taps() + sh;
             for (const level_work& w : levels_) t += level_taps(w);
             return t;
         }
         const level_work& lw = levels_[level_];
-        std::uint64_t t = std::uint64_t(6 - face_) * lw.border_taps;
+        std::uint64_t t = std::uint64_t(6 - face_) * lw.border_taps + sh;
         if (row_ < std::size_t(6 * lw.n)) {
             t += std::uint64_t(6 * lw.n - int(row_)) * lw.taps_per_row;
-            if (!lw.mirror) // the texels of the row's finished chunks and the taps of its current chunk
+            if (!lw.whole_rows()) // the texels of the row's finished chunks and the taps of its current chunk
                 t -= std::uint64_t(lw.chunks[chunk_].first) * lw.texel_taps + std::uint64_t(lw.chunks[chunk_].second) * tap_;
         }
         for (std::size_t p = pos_ + 1; p < order_.size(); ++p) t += level_taps(levels_[order_[p]]);
@@ -232,11 +248,14 @@ public:
     /// call within the budget.
     int level_size(std::size_t k) const noexcept { return levels_[k].n; }
     std::uint64_t row_taps(std::size_t k) const noexcept { return levels_[k].taps_per_row; }
-    /// The dearest of a pass's first units (a packed row of the source, the split's patch).
-    std::uint64_t setup_unit_taps() const noexcept { return std::max(pack_item_taps(0), patch_taps()); }
+    /// The dearest of a pass's first units (a packed row of the source, the split's patch, a row of
+    /// the projection by spherical harmonics).
+    std::uint64_t setup_unit_taps() const noexcept {
+        return std::max({pack_item_taps(0), patch_taps(), src_->sh_rows() > 0 ? sh_row_taps() : std::uint64_t(0)});
+    }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
-        return std::max(lw.border_taps, lw.mirror ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
+        return std::max(lw.border_taps, lw.whole_rows() ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
     }
 
 private:
@@ -249,13 +268,17 @@ private:
         else src_.emplace(*source_, opt_, ex, 0);
         pack_item_ = 0;
         packed_ = false;
-        if (!same_shape) plan_levels();
-        else // the tables stay; the peaks of the fast filter's split belong to the source
+        sh_row_ = 0;
+        if (!same_shape) {
+            plan_levels();
+        } else { // the tables stay; the peaks of the fast filter's split belong to the source
+            src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_)); // the projection's rows: the pass's next units
             for (std::size_t k = 0; k < levels_.size(); ++k)
                 if (!levels_[k].mirror) {
                     levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
                     set_convolved_costs(levels_[k]);
                 }
+        }
         // The chain under construction (the rows are written into it; outside the budget).
         if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
             back_.emplace(first_size_, int(levels_.size()));
@@ -294,6 +317,16 @@ private:
     }
     /// The split's patch: a few texels per peak and level of the packed copy.
     std::uint64_t patch_taps() const noexcept { return 1 + std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
+    /// Coefficients of the spherical-harmonic projection (one source texel, one (l, m): a basis
+    /// value and three multiply-adds) and of a level's reconstruction (one output texel, one (l, m))
+    /// counted as one tap (measured by bench/bench_prefilter.cpp, BM_prefilter_update_step).
+    static constexpr std::size_t sh_project_per_tap = 16;
+    static constexpr std::size_t sh_texel_per_tap = 32;
+    /// A row of the projection: n texels of B^2 coefficients (B the projection's bands).
+    std::uint64_t sh_row_taps() const noexcept {
+        const std::uint64_t b = std::uint64_t(src_->sh_projection_bands());
+        return 1 + (std::uint64_t(src_->sh_projection_face()) * b * b + sh_project_per_tap - 1) / sh_project_per_tap;
+    }
     struct level_work {
         int n = 1;
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
@@ -306,6 +339,8 @@ private:
         std::uint64_t border_taps = 1;       ///< the borders of a face (of the chain, and of as_next when kept)
         std::vector<std::pair<int, int>> chunks; ///< a row's chunks of lanes (first texel, width), as convolve_row
         std::optional<cubemap<float>> as_next; ///< this level before its peaks, which the coarse tail of the level before reads
+        /// A mirror level or a level by spherical harmonics: whole rows are the units.
+        bool whole_rows() const noexcept { return mirror || conv.sh.active(); }
     };
     /// The taps of a whole level: its rows and its faces' borders.
     static std::uint64_t level_taps(const level_work& lw) noexcept {
@@ -313,7 +348,9 @@ private:
     }
 
     static void set_convolved_costs(level_work& lw) noexcept {
-        lw.texel_taps = std::max<std::uint64_t>(1, lw.conv.taps.w.size());
+        const std::uint64_t b = std::uint64_t(lw.conv.sh.bands);
+        lw.texel_taps = lw.conv.sh.active() ? (b * b + sh_texel_per_tap - 1) / sh_texel_per_tap
+                                            : std::max<std::uint64_t>(1, lw.conv.taps.w.size());
         lw.finish_taps = std::uint64_t(lw.n) * ((lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
                                                 (lw.conv.tail_share > 0.f ? 1u : 0u));
         lw.taps_per_row = std::uint64_t(lw.n) * lw.texel_taps + lw.finish_taps;
@@ -328,6 +365,8 @@ private:
         plan_ = prefilter_plan<Lobe>(opt_, base);
         detail::check_prefilter_work(opt_, plan_, base);
         first_size_ = std::max(1, base >> plan_.front().level);
+        // The projection of the levels by spherical harmonics (its rows: the pass's units after the packing).
+        src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_));
         levels_.clear();
         for (std::size_t k = 0; k < plan_.size(); ++k) {
             const prefilter_level& lp = plan_[k];
@@ -338,8 +377,8 @@ private:
                 lw.base = detail::prefilter_base_mode(*source_, lw.n, lp.trilinear);
                 lw.taps_per_row = std::uint64_t(lw.n);
             } else {
-                lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_);
-                lw.conv = src_->level(*source_, lp, lw.tail_roughness);
+                lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_, true);
+                lw.conv = src_->level(*source_, lp, lw.tail_roughness, lw.n);
                 set_convolved_costs(lw);
             }
             levels_.push_back(std::move(lw));
@@ -348,7 +387,7 @@ private:
             if (levels_[k - 1].tail_roughness >= 0.0) levels_[k].as_next.emplace(levels_[k].n, 1);
         for (level_work& lw : levels_) // a face's edges (4 n) and corners, in each cube that keeps the level
             lw.border_taps = (std::uint64_t(4 * lw.n + 4) * (lw.as_next ? 2u : 1u) + border_per_tap - 1) / border_per_tap;
-        order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_);
+        order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_, true);
     }
 
     /// Whole rows [begin, end) of the current level, through the executor.
@@ -460,6 +499,7 @@ private:
     std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
     std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
     std::size_t pack_item_ = 0;         ///< the next packing item of the pass's first units
+    std::size_t sh_row_ = 0;            ///< the next row of the projection by spherical harmonics
     bool packed_ = false;               ///< the packed copy (and its patch) done
     detail::lane_sums<16> sums16_{};    ///< the current chunk's sums (by its width)
     detail::lane_sums<8> sums8_{};

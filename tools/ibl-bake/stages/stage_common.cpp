@@ -449,11 +449,13 @@ std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, 
 }
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
-ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
-                               prefilter_choice method, std::uint32_t fast_peaks) {
+ibl::prefilter_options chain_options(const ibl::specular_plan& sp, ibl::ld_weight w, prefilter_choice method, std::uint32_t fast_peaks,
+                                     int fast_sh_bands) {
     ibl::prefilter_options o;
     o.peaks.enabled = fast_peaks > 0;
     o.peaks.max_peaks = fast_peaks;
+    o.sh_rough.enabled = fast_sh_bands > 0;
+    o.sh_rough.max_bands = fast_sh_bands;
     o.base_size = sp.virtual_base_size;
     o.policy = sp.policy;
     o.weight = w;
@@ -461,7 +463,12 @@ ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specul
     for (const ibl::specular_level_plan& lp : sp.levels) // the mirror level copies the nearest source level
         o.level_plan.push_back({lp.level, lp.roughness, chain_samples(lp.samples, method, lp.level),
                                 lp.level > 0 && lp.trilinear && method != prefilter_choice::fast});
-    return ibl::cubemap<float>(ibl::prefilter(src, o, ex));
+    return o;
+}
+
+ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
+                               prefilter_choice method, std::uint32_t fast_peaks, int fast_sh_bands) {
+    return ibl::cubemap<float>(ibl::prefilter(src, chain_options(sp, w, method, fast_peaks, fast_sh_bands), ex));
 }
 
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex) {

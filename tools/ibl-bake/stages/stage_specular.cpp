@@ -84,7 +84,14 @@ public:
         ctx.prog.begin("prefilter");
         weight_ = ctx.opt.ld_weight;
         method_ = ctx.opt.prefilter;
-        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_, ctx.opt.fast_peaks);
+        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands);
+        if (method_ == prefilter_choice::fast) { // the bands of each level by spherical harmonics (0: its tap set)
+            const ibl::prefilter_options po =
+                chain_options(ctx.plan.specular, weight_, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands);
+            sh_bands_.clear();
+            for (const ibl::prefilter_level& lp : po.level_plan) sh_bands_.push_back(ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(po, lp));
+            sh_max_bands_ = ctx.opt.fast_sh_bands;
+        }
         ms_ = ctx.prog.end();
         if (method_ == prefilter_choice::fast && ctx.opt.fast_peaks > 0) { // the split again, for the report (untimed)
             ibl::peak_split_options po;
@@ -151,6 +158,8 @@ private:
     quality_settings qs_{};
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     prefilter_choice method_ = prefilter_choice::fis;
+    std::vector<int> sh_bands_; ///< per stored level, the fast filter's spherical-harmonic bands (0: taps)
+    int sh_max_bands_ = 0;
     struct peak_report {
         bool on = false;
         double ratio = 0.0;
@@ -282,8 +291,9 @@ void specular_stage::report(json_writer& j) const {
                                           ? std::string("GGX fast filter (ibl::prefilter_method::fast: spiral tap sets shaped offline, "
                                                         "read from the exact-solid-angle mips; coarse tail: each level's kernel tail "
                                                         "read from the next level of face >= 16") +
-                                                (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel), "
-                                                           : "), ")
+                                                (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel" : "") +
+                                                (sh_max_bands_ > 0 ? "; rough levels by spherical-harmonic convolution of the source), "
+                                                                   : "), ")
                                           : "GGX filtered importance sampling (Krivanek-Colbert), ") +
                           (sp_.trilinear && method_ != prefilter_choice::fast ? "trilinear" : "nearest-level") +
                           " source reads, N = V = R, weight " +
@@ -297,6 +307,10 @@ void specular_stage::report(json_writer& j) const {
     else j.key("lod_bias").value(0.5);
     j.end_object();
     if (method_ == prefilter_choice::fast) {
+        j.key("sh_levels").begin_object().key("max_bands").value(sh_max_bands_).key("tolerance").value(ibl::sh_rough_options{}.tolerance);
+        j.key("bands_per_level").begin_array();
+        for (const int b : sh_bands_) j.value(b);
+        j.end_array().end_object();
         j.key("peaks").begin_object().key("enabled").value(peaks_.on);
         if (peaks_.on)
             j.key("ratio").value(peaks_.ratio).key("max_peaks").value(peaks_.max_peaks).key("count").value(std::uint64_t(peaks_.count))

@@ -1,0 +1,232 @@
+// research/sh_rough_study.cpp — the rough levels of a prefiltered chain by spherical-harmonic
+// convolution: error against the exact LD per band count and projection level.
+//
+//   build/release/research/sh_rough_study [--texels N] [FILE.exr ...]   (default: the courtyard and
+//                                                                         studio of tests/data, 400)
+//   build/release/research/sh_rough_study --quick                        (ctest: one file, 32 texels)
+//
+// The LD kernel at normal view is zonal about R, so by the Funk-Hecke theorem
+//     LD(R) = sum_(l,m) k_l L_lm Y_lm(R),   k_l = integral K(theta) P_l(cos theta) dOmega / integral K dOmega,
+// exact for a source band-limited to B - 1. The error of a B-band reconstruction is the kernel's
+// mass above band B - 1 (k_l falls like exp(-2 alpha l) for the core; the cut at the horizon
+// leaves a slow k_l ~ l^-2 tail) times the source's power there, plus the projection's quadrature
+// (texel centres of a mip of face m, exact texel solid angles). The reference is the one of
+// fast_tap_study: ibl::ld_texel_sum over level 0 of the 256^2 source cube at N random texels of each
+// level of a 256^2, 6-level chain (r = l / 5, n.l weight). Double throughout (the study measures the
+// method's error, not a float kernel's).
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <span>
+#include <string>
+#include <vector>
+
+#include <ibl/bake/prefilter.hpp>
+#include <ibl/core/executor.hpp>
+#include <ibl/env/convert.hpp>
+#include <ibl/env/latlong.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
+#include <ibl/reference/radiance.hpp>
+
+#include "io/image_io.hpp"
+
+using dvec3 = ibl::vec3<double>;
+
+namespace {
+double unit(std::uint32_t a, std::uint32_t b) {
+    return double(ibl::detail::rr_hash(ibl::detail::rr_hash(a * 0x9e3779b9u + 17u) ^ b) >> 8) * 0x1p-24;
+}
+double lum(const dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
+
+/// Real orthonormal SH of bands 0..B-1 at the unit direction d (zonal about +Z, no Condon-Shortley
+/// phase), index l*l + l + m: the normalised associated Legendre recurrence in z times
+/// Re / Im (x + i y)^m.
+void sh_eval(int B, const dvec3& d, double* y) {
+    double q_mm = 0.5 / std::sqrt(ibl::pi_v<double>); // Q_00
+    double cr = 1.0, ci = 0.0;                         // (x + i y)^m
+    for (int m = 0; m < B; ++m) {
+        if (m > 0) {
+            q_mm *= std::sqrt((2.0 * m + 1.0) / (2.0 * m));
+            const double nr = cr * d.x - ci * d.y, ni = cr * d.y + ci * d.x;
+            cr = nr, ci = ni;
+        }
+        const double s = m == 0 ? 1.0 : std::sqrt(2.0);
+        double q2 = 0.0, q1 = q_mm;
+        for (int l = m; l < B; ++l) {
+            double q;
+            if (l == m) q = q_mm;
+            else if (l == m + 1) q = d.z * std::sqrt(2.0 * m + 3.0) * q_mm;
+            else {
+                const double a = std::sqrt((4.0 * l * l - 1.0) / (double(l) * l - double(m) * m));
+                const double b = std::sqrt((double(l - 1) * (l - 1) - double(m) * m) / (4.0 * (l - 1) * (l - 1) - 1.0));
+                q = a * (d.z * q1 - b * q2);
+            }
+            if (l > m) q2 = q1, q1 = q;
+            if (m == 0) y[l * l + l] = q;
+            else {
+                y[l * l + l + m] = s * q * cr;
+                y[l * l + l - m] = s * q * ci;
+            }
+        }
+    }
+}
+
+struct texel_ref {
+    int f, x, y;
+    dvec3 dir, ref;
+};
+constexpr int chain_levels = 6;
+constexpr int base_size = 256;
+double level_r(int l) { return double(l) / double(chain_levels - 1); }
+} // namespace
+
+int main(int argc, char** argv) {
+    int texels = 400;
+    std::vector<std::string> files;
+    bool quick = false;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        if (a == "--texels" && i + 1 < argc) texels = std::max(16, std::atoi(argv[++i]));
+        else if (a == "--quick") quick = true;
+        else files.push_back(a);
+    }
+    if (files.empty()) files = {std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr", std::string(IBL_RESEARCH_DATA_DIR) + "/studio.exr"};
+    if (quick) files.resize(1), texels = 32;
+    const ibl::ld_weight w = ibl::ld_weight::n_dot_l;
+    const std::vector<int> bands = quick ? std::vector<int>{8} : std::vector<int>{6, 8, 10, 12, 16, 20, 24, 32};
+    const int max_b = *std::max_element(bands.begin(), bands.end());
+    ibl::thread_executor ex{2};
+    int bad = 0;
+    for (const std::string& file : files) {
+        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file, {});
+        ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);
+        map.update_borders();
+        const int k = std::max(2, int(std::ceil(double(img.width) / (4.0 * base_size))));
+        const ibl::cubemap<float> cube = ibl::bake_cubemap<float>(map, base_size, k, ex, 0);
+        std::vector<std::vector<texel_ref>> refs(chain_levels);
+        for (int l = 1; l < chain_levels; ++l) {
+            const int n = base_size >> l;
+            auto& rl = refs[std::size_t(l)];
+            rl.resize(std::size_t(texels));
+            std::vector<dvec3> dirs(rl.size());
+            for (std::size_t i = 0; i < rl.size(); ++i) {
+                texel_ref& t = rl[i];
+                t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
+                t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
+                t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
+                t.dir = dirs[i] = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
+            }
+            const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), level_r(l), w, ex);
+            for (std::size_t i = 0; i < rl.size(); ++i) rl[i].ref = exact[i];
+        }
+        std::printf("\n%s: 256^2 source, levels 2-5 of a 6-level chain (r = l/5), n.l weight, %d texels per level; "
+                    "reference ibl::ld_texel_sum over level 0\n\n",
+                    file.substr(file.find_last_of('/') + 1).c_str(), texels);
+        // The library: ibl::prefilter's fast filter (tool default: split and coarse tail) with and
+        // without the rough levels by spherical harmonics, levels 1-5.
+        std::printf("| ibl::prefilter fast | levels by SH (bands) | levels 1-5 rel RMSE |\n|---|---|---|\n");
+        for (std::uint32_t n0 : quick ? std::vector<std::uint32_t>{16u} : std::vector<std::uint32_t>{16u, 32u, 48u, 64u}) {
+            std::array<std::array<double, chain_levels>, 2> err{};
+            for (int sh = 0; sh < 2; ++sh) {
+                ibl::prefilter_options o;
+                o.method = ibl::prefilter_method::fast;
+                o.levels = chain_levels;
+                for (int l = 0; l < chain_levels; ++l) o.samples_per_level.push_back(ibl::equal_cost_prefilter_samples(n0, l));
+                o.weight = w;
+                o.sh_rough.enabled = sh == 1; // the default
+                const ibl::specular_chain ch = ibl::prefilter(cube, o, ex);
+                std::string b;
+                for (int l = 1; l < chain_levels; ++l) {
+                    ibl::prefilter_level lp;
+                    lp.level = l, lp.roughness = level_r(l);
+                    const int nb = ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(o, lp);
+                    if (!b.empty()) b.push_back(' ');
+                    if (nb) b.append(std::to_string(nb));
+                    else b.push_back('-');
+                }
+                std::printf("| %u x 4^(l-1) samples | %s |", n0, b.c_str());
+                for (int l = 1; l < chain_levels; ++l) {
+                    double s2 = 0;
+                    for (const texel_ref& t : refs[std::size_t(l)]) {
+                        const dvec3 v(ch.texel(t.f, t.x, t.y, l));
+                        const double a = lum(v), bb = lum(t.ref);
+                        s2 += (a - bb) * (a - bb) / (bb * bb);
+                    }
+                    const double e = std::sqrt(s2 / double(refs[std::size_t(l)].size()));
+                    bad += std::isfinite(e) ? 0 : 1;
+                    err[std::size_t(sh)][std::size_t(l)] = e;
+                    std::printf(" %.3g", e);
+                }
+                std::printf(" |\n");
+                std::fflush(stdout);
+            }
+            // --quick (ctest): the levels by spherical harmonics below the tap sets on levels 2-5.
+            for (int l = 2; l < chain_levels; ++l)
+                if (!(err[1][std::size_t(l)] < err[0][std::size_t(l)])) {
+                    std::printf("level %d: spherical harmonics %g not below the tap set %g\n", l, err[1][std::size_t(l)], err[0][std::size_t(l)]);
+                    ++bad;
+                }
+        }
+        std::printf("\n| projected from (face) | bands | levels 2-5 rel RMSE |\n|---|---|---|\n");
+        for (int pl : quick ? std::vector<int>{3} : std::vector<int>{1, 2, 3}) {
+            const int m = cube.size(pl);
+            // Project level pl once to max_b bands (the lower band counts are its prefixes).
+            const int nc = max_b * max_b;
+            std::vector<std::array<std::vector<double>, 3>> part(6);
+            ex(6, [&](std::size_t b, std::size_t e) {
+                std::vector<double> y(static_cast<std::size_t>(nc));
+                for (std::size_t f = b; f < e; ++f) {
+                    for (auto& c : part[f]) c.assign(std::size_t(nc), 0.0);
+                    for (int ty = 0; ty < m; ++ty)
+                        for (int tx = 0; tx < m; ++tx) {
+                            const dvec3 d = ibl::cube_texel_direction<double>(int(f), tx, ty, m);
+                            const double om = ibl::cube_texel_solid_angle<double>(tx, ty, m);
+                            const dvec3 L(cube.texel(int(f), tx, ty, pl));
+                            sh_eval(max_b, d, y.data());
+                            for (int i = 0; i < nc; ++i) {
+                                const double v = y[std::size_t(i)] * om;
+                                part[f][0][std::size_t(i)] += v * L.x;
+                                part[f][1][std::size_t(i)] += v * L.y;
+                                part[f][2][std::size_t(i)] += v * L.z;
+                            }
+                        }
+                }
+            });
+            std::array<std::vector<double>, 3> coef;
+            for (int c = 0; c < 3; ++c) {
+                coef[std::size_t(c)].assign(std::size_t(nc), 0.0);
+                for (int f = 0; f < 6; ++f)
+                    for (int i = 0; i < nc; ++i) coef[std::size_t(c)][std::size_t(i)] += part[std::size_t(f)][std::size_t(c)][std::size_t(i)];
+            }
+            for (int B : bands) {
+                std::printf("| level %d (%d^2) | %d |", pl, m, B);
+                std::vector<double> y(static_cast<std::size_t>(max_b * max_b));
+                for (int l = 2; l < chain_levels; ++l) {
+                    const std::vector<double> kl = ibl::detail::zonal_band_factors<ibl::ggx_lobe>(B, level_r(l), w);
+                    double s = 0;
+                    for (const texel_ref& t : refs[std::size_t(l)]) {
+                        sh_eval(B, t.dir, y.data());
+                        dvec3 v(0.0);
+                        for (int bl = 0; bl < B; ++bl)
+                            for (int mm = -bl; mm <= bl; ++mm) {
+                                const std::size_t i = std::size_t(bl * bl + bl + mm);
+                                const double g = kl[std::size_t(bl)] * y[i];
+                                v.x += g * coef[0][i], v.y += g * coef[1][i], v.z += g * coef[2][i];
+                            }
+                        const double a = lum(v), b = lum(t.ref);
+                        s += (a - b) * (a - b) / (b * b);
+                    }
+                    const double e = std::sqrt(s / double(refs[std::size_t(l)].size()));
+                    bad += std::isfinite(e) ? 0 : 1;
+                    std::printf(" %.3g", e);
+                }
+                std::printf(" |\n");
+                std::fflush(stdout);
+            }
+        }
+    }
+    return bad ? 1 : 0;
+}
