@@ -561,17 +561,18 @@ public:
     }
     /// The taps of a plan level (tables from the source's lod mapping), its peaks and its coarse
     /// tail from the level of roughness next_roughness (< 0: none).
-    /// n: the level's face size. A level by spherical harmonics needs sh_setup first.
-    template <class Env>
-    prefilter_cube_level level(const Env& env, const prefilter_level& lp, double next_roughness, int n) const {
+    /// n: the level's face size; ex computes a level by spherical harmonics' norm (once per level
+    /// shape; such a level needs sh_setup first).
+    template <class Env, class Executor>
+    prefilter_cube_level level(const Env& env, const prefilter_level& lp, double next_roughness, int n, Executor& ex) const {
         prefilter_cube_level lv;
         lv.peaks = level_peaks(lp);
         if (const int bands = prefilter_sh_bands<Lobe>(opt_, lp); bands > 0 && proj_.bands() >= bands) {
             lv.sh.bands = bands;
             lv.sh.rec = sh_recurrence(bands);
-            const std::vector<double>& k = *lobe_band_factors<Lobe>(clamped(lp.roughness), opt_.weight);
-            lv.sh.k.assign(k.begin(), k.begin() + bands);
-            lv.sh.norm = sh_level_norm_for<Lobe>(lv.sh, clamped(lp.roughness), opt_.weight, proj_, n);
+            const std::shared_ptr<const std::vector<double>> k = lobe_band_factors<Lobe>(clamped(lp.roughness), opt_.weight);
+            lv.sh.k.assign(k->begin(), k->begin() + bands);
+            lv.sh.norm = sh_level_norm_for<Lobe>(lv.sh, clamped(lp.roughness), opt_.weight, proj_, n, ex);
             sh_fill(lv);
             return lv;
         }
@@ -672,7 +673,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 });
             } else {
                 const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0), true);
-                const detail::prefilter_cube_level lv = cs.level(env, lp, rn, n);
+                const detail::prefilter_cube_level lv = cs.level(env, lp, rn, n, ex);
                 const cubemap<float>* nx = rn >= 0.0 && next ? &*next : nullptr;
                 // The level before this one reads its coarse tail from this level without its peaks
                 // (they are added to every level exactly, through its own kernel).

@@ -134,7 +134,8 @@ template <class Lobe> std::shared_ptr<const std::vector<double>> lobe_band_facto
 template <class Lobe> int sh_rough_bands(double roughness, ld_weight weight, const sh_rough_options& o) {
     if (!o.enabled || !(o.tolerance > 0.0)) return 0;
     const int cap = std::clamp(o.max_bands, 0, sh_rough_band_limit);
-    const std::vector<double>& k = *lobe_band_factors<Lobe>(roughness, weight);
+    const std::shared_ptr<const std::vector<double>> kp = lobe_band_factors<Lobe>(roughness, weight); // kept alive
+    const std::vector<double>& k = *kp;
     std::vector<double> tail(k.size() + 1, 0.0); // tail[B] = sum_(l >= B)
     for (std::size_t l = k.size(); l-- > 0;)
         tail[l] = tail[l + 1] + (2.0 * double(l) + 1.0) * k[l] * k[l] / ((double(l) + 1.0) * (double(l) + 1.0));
@@ -478,20 +479,24 @@ inline void sh_level_row(const sh_level& lv, int face, int y, int n, vec3<float>
 }
 
 /// The norm of an n x n level (sh_level::norm) from the projection's unit coefficients (of
-/// proj_bands bands): the level's k_l applied to them, reconstructed at every texel.
-inline std::vector<float> sh_level_norm(const sh_level& lv, const std::vector<double>& unit, int proj_bands, int n) {
+/// proj_bands bands): the level's k_l applied to them, reconstructed at every texel (face rows
+/// through the executor: rows are independent).
+template <class Executor>
+std::vector<float> sh_level_norm(const sh_level& lv, const std::vector<double>& unit, int proj_bands, int n, Executor& ex) {
     sh_level u;
     u.bands = lv.bands;
     u.rec = lv.rec;
     u.k = lv.k;
     u.set_coefficients(unit, proj_bands);
-    std::vector<vec3<float>> row(static_cast<std::size_t>(n));
     std::vector<float> norm(static_cast<std::size_t>(6 * n * n));
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y) {
+    ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+        std::vector<vec3<float>> row(static_cast<std::size_t>(n));
+        for (std::size_t r = b; r < e; ++r) {
+            const int f = int(r) / n, y = int(r) % n;
             sh_level_row(u, f, y, n, row.data());
             for (int x = 0; x < n; ++x) norm[cube_texel_index(f, x, y, n)] = row[std::size_t(x)].x;
         }
+    });
     return norm;
 }
 
@@ -502,9 +507,10 @@ inline std::shared_ptr<const std::vector<double>> sh_unit_coefficients(const sh_
 }
 /// The norm of a level of lobe L (its k_l in lv) at face size n for the projection p, memoised for
 /// GGX (by roughness, weight, bands, the projection's bands and face, n).
-template <class Lobe>
-std::shared_ptr<const std::vector<float>> sh_level_norm_for(const sh_level& lv, double roughness, ld_weight weight, const sh_projection& p, int n) {
-    auto make = [&] { return sh_level_norm(lv, *sh_unit_coefficients(p), p.bands(), n); };
+template <class Lobe, class Executor>
+std::shared_ptr<const std::vector<float>> sh_level_norm_for(const sh_level& lv, double roughness, ld_weight weight, const sh_projection& p, int n,
+                                                            Executor& ex) {
+    auto make = [&] { return sh_level_norm(lv, *sh_unit_coefficients(p), p.bands(), n, ex); };
     if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
         using key = std::tuple<double, int, int, int, int, int>;
         return fast_memo<key, std::vector<float>>(key(roughness, int(weight), lv.bands, p.bands(), p.face_size(), n), make);

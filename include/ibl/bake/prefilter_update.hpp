@@ -378,7 +378,8 @@ private:
                 lw.taps_per_row = std::uint64_t(lw.n);
             } else {
                 lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_, true);
-                lw.conv = src_->level(*source_, lp, lw.tail_roughness, lw.n);
+                serial_executor one;
+                lw.conv = src_->level(*source_, lp, lw.tail_roughness, lw.n, one);
                 set_convolved_costs(lw);
             }
             levels_.push_back(std::move(lw));
