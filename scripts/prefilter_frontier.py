@@ -3,7 +3,7 @@
 
 For each input (the shared HDRIs given with --input, and the built-in sky + sun) and each filter
 setting (filtered importance sampling and the fast filter at --quality low / default / high, the
-fast filter without its peak split), runs
+fast filter without its peak split, and without its rough levels by spherical harmonics), runs
 
     ibl-bake [--input F] --prefilter M [--quality Q] [--fast-peaks 0] --threads 2 --out DIR
 
@@ -36,6 +36,7 @@ SETTINGS = [
     ("fast", ["--prefilter", "fast"], "fast default"),
     ("fast", ["--prefilter", "fast", "--quality", "high"], "fast high"),
     ("fast0", ["--prefilter", "fast", "--fast-peaks", "0"], "fast default, no peak split"),
+    ("fastsh0", ["--prefilter", "fast", "--fast-sh-bands", "0"], "fast default, tap sets on every level (no SH levels)"),
 ]
 
 
@@ -106,6 +107,8 @@ def main():
                 for r in rows:
                     if r["input"] == name and r["kind"] == "fast0":
                         ax.plot(r["time_ms"], r["levels"][li], "x", color=colours.get(name, "k"), ms=6)
+                    if r["input"] == name and r["kind"] == "fastsh0":
+                        ax.plot(r["time_ms"], r["levels"][li], "+", color=colours.get(name, "k"), ms=7)
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_title(f"level {li + 1}")
@@ -113,7 +116,8 @@ def main():
             ax.grid(True, which="both", alpha=0.3)
         (axes[0] if nlev > 1 else axes).set_ylabel("rel RMSE (ibl-bake check)")
         (axes[-1] if nlev > 1 else axes).legend(fontsize=6)
-        fig.suptitle("Prefilter error against time: FIS (squares) and the fast filter (circles; x = no peak split)",
+        fig.suptitle("Prefilter error against time: FIS (squares) and the fast filter (circles; x = no peak split, "
+                     "+ = tap sets on every level)",
                      fontsize=9)
         fig.tight_layout()
         fig.savefig(a.plot, dpi=110)

@@ -52,8 +52,8 @@
 // filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels),
 // then, when the fast filter reconstructs rough levels from spherical harmonics
 // (bake/prefilter_sh.hpp), the projection of the packed source, a row of its level per unit
-// (1 + ceil(m B^2 / 16) taps for m texels and B bands; the last row also reduces the sums). A
-// level by spherical harmonics is computed in whole rows, n_l ceil(B_l^2 / 32) taps plus the
+// (1 + ceil(m B^2 / 12) taps for m texels and B bands), then the reduction of its sums (one unit). A
+// level by spherical harmonics is computed in whole rows of 16-lane chunks, 16 ceil(n_l / 16) ceil(B_l^2 / 24) taps plus the
 // row's peaks (as its finish), like a mirror level's rows.
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
@@ -139,12 +139,18 @@ public:
             }
             if (sh_row_ < src_->sh_rows()) { // the projection of the levels by spherical harmonics, a row per unit
                 if (spent > 0 && sh_row_taps() > budget - spent) break;
-                src_->sh_add_row(sh_row_);
+                src_->sh_add_row(sh_row_++);
                 spent += sh_row_taps();
-                if (++sh_row_ == src_->sh_rows()) { // its last row also reduces the sums
+                continue;
+            }
+            if (!sh_done_) { // then the reduction of its sums and the levels' coefficients, one unit
+                if (src_->sh_rows() > 0) {
+                    if (spent > 0 && sh_finish_taps() > budget - spent) break;
                     src_->sh_finish();
                     for (level_work& w : levels_) src_->sh_fill(w.conv);
+                    spent += sh_finish_taps();
                 }
+                sh_done_ = true;
                 continue;
             }
             const level_work& lw = levels_[level_];
@@ -219,13 +225,13 @@ public:
     const std::optional<specular_chain>& result() const noexcept { return result_; }
     /// Taps of a whole pass, and those still to compute in the current one.
     std::uint64_t total_taps() const noexcept {
-        std::uint64_t t = setup_taps(0) + patch_taps() + std::uint64_t(src_->sh_rows()) * sh_row_taps();
+        std::uint64_t t = setup_taps(0) + patch_taps() + sh_taps(0);
         for (const level_work& lw : levels_) t += level_taps(lw);
         return t;
     }
     std::uint64_t remaining_taps() const noexcept {
         if (pass_done_) return 0;
-        const std::uint64_t sh = std::uint64_t(src_->sh_rows() - sh_row_) * sh_row_taps();
+        const std::uint64_t sh = sh_done_ ? 0 : sh_taps(sh_row_);
         if (!packed_) {
             std::uint64_t t = setup_taps(pack_item_) + patch_taps() + sh;
             for (const level_work& w : levels_) t += level_taps(w);
@@ -251,7 +257,7 @@ public:
     /// The dearest of a pass's first units (a packed row of the source, the split's patch, a row of
     /// the projection by spherical harmonics).
     std::uint64_t setup_unit_taps() const noexcept {
-        return std::max({pack_item_taps(0), patch_taps(), src_->sh_rows() > 0 ? sh_row_taps() : std::uint64_t(0)});
+        return std::max({pack_item_taps(0), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
     }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
@@ -269,6 +275,7 @@ private:
         pack_item_ = 0;
         packed_ = false;
         sh_row_ = 0;
+        sh_done_ = false;
         if (!same_shape) {
             plan_levels();
         } else { // the tables stay; the peaks of the fast filter's split belong to the source
@@ -320,12 +327,23 @@ private:
     /// Coefficients of the spherical-harmonic projection (one source texel, one (l, m): a basis
     /// value and three multiply-adds) and of a level's reconstruction (one output texel, one (l, m))
     /// counted as one tap (measured by bench/bench_prefilter.cpp, BM_prefilter_update_step).
-    static constexpr std::size_t sh_project_per_tap = 16;
-    static constexpr std::size_t sh_texel_per_tap = 32;
+    static constexpr std::size_t sh_project_per_tap = 12;
+    static constexpr std::size_t sh_texel_per_tap = 24;
     /// A row of the projection: n texels of B^2 coefficients (B the projection's bands).
     std::uint64_t sh_row_taps() const noexcept {
         const std::uint64_t b = std::uint64_t(src_->sh_projection_bands());
         return 1 + (std::uint64_t(src_->sh_projection_face()) * b * b + sh_project_per_tap - 1) / sh_project_per_tap;
+    }
+    /// The reduction of the projection's sums (six faces, eight lanes, six sums per (l, m) pair, in
+    /// double; sh_reduce_per_tap of them a tap) and the levels' coefficients.
+    static constexpr std::size_t sh_reduce_per_tap = 8;
+    std::uint64_t sh_finish_taps() const noexcept {
+        const std::uint64_t b = std::uint64_t(src_->sh_projection_bands());
+        return 1 + (6 * 6 * 8 * (b * (b + 1) / 2) + sh_reduce_per_tap - 1) / sh_reduce_per_tap;
+    }
+    /// The projection's units from row `row` on, with the reduction.
+    std::uint64_t sh_taps(std::size_t row) const noexcept {
+        return src_->sh_rows() > 0 ? std::uint64_t(src_->sh_rows() - row) * sh_row_taps() + sh_finish_taps() : 0;
     }
     struct level_work {
         int n = 1;
@@ -351,9 +369,11 @@ private:
         const std::uint64_t b = std::uint64_t(lw.conv.sh.bands);
         lw.texel_taps = lw.conv.sh.active() ? (b * b + sh_texel_per_tap - 1) / sh_texel_per_tap
                                             : std::max<std::uint64_t>(1, lw.conv.taps.w.size());
+        // a level by spherical harmonics computes its rows in chunks of 16 lanes (a row's last chunk whole)
+        const std::uint64_t lanes = lw.conv.sh.active() ? std::uint64_t((lw.n + 15) / 16 * 16) : std::uint64_t(lw.n);
         lw.finish_taps = std::uint64_t(lw.n) * ((lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
                                                 (lw.conv.tail_share > 0.f ? 1u : 0u));
-        lw.taps_per_row = std::uint64_t(lw.n) * lw.texel_taps + lw.finish_taps;
+        lw.taps_per_row = lanes * lw.texel_taps + lw.finish_taps;
         lw.chunks.clear();
         int x = 0;
         for (const int w : {int(detail::convolve_width), 8, 4, 1})
@@ -501,6 +521,7 @@ private:
     std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
     std::size_t pack_item_ = 0;         ///< the next packing item of the pass's first units
     std::size_t sh_row_ = 0;            ///< the next row of the projection by spherical harmonics
+    bool sh_done_ = false;              ///< its sums reduced and the levels' coefficients set
     bool packed_ = false;               ///< the packed copy (and its patch) done
     detail::lane_sums<16> sums16_{};    ///< the current chunk's sums (by its width)
     detail::lane_sums<8> sums8_{};
