@@ -41,28 +41,35 @@ bool same_bits(const ibl::cubemap<float>& a, const ibl::cubemap<float>& b) { ret
 
 } // namespace
 
-TEST_CASE("prefilter_sh: the recurrence's basis is sh/basis.hpp's for bands 0-4") {
-    const ibl::detail::sh_recurrence rec(5);
-    float x[8], y[8], z[8];
-    for (int k = 0; k < 8; ++k) {
-        const ibl::vec3<float> d = glm::normalize(ibl::vec3<float>(std::sin(1.3f * float(k) + 0.2f), std::cos(2.1f * float(k)) - 0.3f,
-                                                                   0.7f * float(k) / 8.f - 0.45f));
-        x[k] = d.x, y[k] = d.y, z[k] = d.z;
-    }
-    float got[25][8];
-    ibl::detail::sh_lanes<8>(rec, x, y, z, [&](int l, int m, const float* q, const float* cr, const float* ci) {
-        for (int k = 0; k < 8; ++k) {
-            if (m == 0) got[ibl::detail::sh_index(l, 0)][k] = q[k];
-            else {
-                got[ibl::detail::sh_index(l, m)][k] = std::sqrt(2.f) * q[k] * cr[k];
-                got[ibl::detail::sh_index(l, -m)][k] = std::sqrt(2.f) * q[k] * ci[k];
+TEST_CASE("prefilter_sh: the reconstruction's basis is sh/basis.hpp's for bands 0-4") {
+    // One coefficient at a time (plus a constant that keeps the clamped output positive) through
+    // the level kernel itself: with k_l = 1 a texel reads 4 Y_00 + Y_lm at its centre direction.
+    const int B = 5, n = 16;
+    const ibl::vec3<double> dirs[] = {ibl::cube_texel_direction<double>(0, 3, 11, n), ibl::cube_texel_direction<double>(2, 15, 0, n),
+                                      ibl::cube_texel_direction<double>(5, 7, 8, n)};
+    const int at[3][3] = {{0, 3, 11}, {2, 15, 0}, {5, 7, 8}};
+    for (int l = 0; l < B; ++l)
+        for (int m = -l; m <= l; ++m) {
+            ibl::detail::sh_level lv;
+            lv.bands = B;
+            lv.rec = ibl::detail::sh_recurrence(B);
+            lv.k.assign(B, 1.0);
+            // the projection's layout: m outer, l inner, six sums per (l, m) (cosine R G B, sine R G B)
+            std::vector<double> proj(ibl::detail::sh_pair_count(B) * 6, 0.0);
+            auto pair = [&](int ll, int mm) { return std::size_t(mm * B - mm * (mm - 1) / 2 + (ll - mm)); };
+            proj[pair(0, 0) * 6] = 4.0 * std::sqrt(4.0 * ibl_test::ld_pi); // 4 / Y_00
+            // L_lm = sqrt(2) x the cosine (sine) sum for m > 0 (m < 0): a sum of 1 / sqrt(2) is L_lm = 1
+            proj[pair(l, std::abs(m)) * 6 + (m < 0 ? 3 : 0)] += m == 0 ? 1.0 : 1.0 / std::sqrt(2.0);
+            lv.set_coefficients(proj, B);
+            for (int i = 0; i < 3; ++i) {
+                std::vector<ibl::vec3<float>> row(n);
+                ibl::detail::sh_level_row(lv, at[i][0], at[i][2], n, row.data());
+                const auto y = ibl::sh_basis<5>(ibl::vec3<float>(dirs[i]));
+                INFO("l " << l << " m " << m << " texel " << i);
+                CHECK(row[std::size_t(at[i][1])].x == doctest::Approx(4.0 + y[ibl::detail::sh_index(l, m)]).epsilon(1e-5));
+                CHECK(row[std::size_t(at[i][1])].y == 0.f);
             }
         }
-    });
-    for (int k = 0; k < 8; ++k) {
-        const auto want = ibl::sh_basis<5>(ibl::vec3<float>(x[k], y[k], z[k]));
-        for (int i = 0; i < 25; ++i) CHECK(got[i][k] == doctest::Approx(want[std::size_t(i)]).epsilon(1e-5).scale(1.0));
-    }
 }
 
 TEST_CASE("prefilter_sh: band factors of the LD kernel match its moments; the band choice") {

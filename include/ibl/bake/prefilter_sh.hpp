@@ -17,7 +17,7 @@
 // a real HDRI at r >= 0.4 (docs/ibl-bake.md, "Fast filter"), because its error is the aliasing of
 // the source's detail through footprints that vary texel to texel; the projection reads every
 // source texel once and the reconstruction costs B^2 multiply-adds per output texel, about
-// 10 - 40 taps' time at B = 10 - 22.
+// 5 - 25 taps' time at B = 11 - 24.
 //
 // Bands per level. The truncation error on a source whose band powers fall like (l + 1)^-2
 // (natural illumination: Dror, Willsky & Adelson 2004) is
@@ -25,14 +25,14 @@
 //     e(B)^2 = sum_(l >= B) (2l + 1) k_l^2 / (l + 1)^2  /  sum_(l >= 0) (2l + 1) k_l^2 / (l + 1)^2,
 //
 // and a level takes the smallest B with e(B) <= tolerance (sh_rough_options; k_l to l = 96). For
-// GGX with the n.l weight at tolerance 5e-4 that is 22 bands at r = 0.4, 11 at 0.6, 10 at 0.8
-// and 14 at 1; r = 0.2 would need about 60 and keeps its tap set. The peak split
+// GGX with the n.l weight at tolerance 5e-4 that is 24 bands at r = 0.4, 11 at 0.6, 13 at 0.8
+// and 17 at 1 (the cut at the horizon); r = 0.2 would need about 60 and keeps its tap set. The peak split
 // (bake/prefilter_peaks.hpp) takes a sun out of the source before the projection, so the
 // truncation never rings around a light 10^4 times the sky: the projection reads the split's base.
 //
 // Projection. The coefficients are sums over the texels of one mip of the packed source (the
-// split's base), the finest whose face is at most 4 B_max (at least 16; the source's finest level
-// if it is coarser): L_lm = sum_texels L Y_lm(d) Omega, with d the texel's centre direction and
+// split's base), the finest whose face is at most max(16, 2 B_max) (the coarsest level when none
+// is): L_lm = sum_texels L Y_lm(d) Omega, with d the texel's centre direction and
 // Omega its exact solid angle (cube_texel_solid_angle). Each face row is a work unit; the lanes'
 // float sums of a face are kept per face and reduced, in a fixed order, in double, so the result
 // does not depend on how the rows are split over threads or calls.
@@ -41,8 +41,7 @@
 // (no trigonometry; zonal about +Z; the basis of sh/basis.hpp for l < 5, which
 // tests/test_prefilter_sh.cpp checks): with Q_l^m = P_l^m / sin^m theta normalised,
 //     Q_0^0 = 1 / (2 sqrt(pi)),  Q_m^m = sqrt((2m + 1) / (2m)) Q_(m-1)^(m-1),
-//     Q_(m+1)^m = sqrt(2m + 3) z Q_m^m,
-//     Q_l^m = a_lm (z Q_(l-1)^m - b_lm Q_(l-2)^m),  a = sqrt((4l^2 - 1) / (l^2 - m^2)),
+//     Q_l^m = a_lm (z Q_(l-1)^m - b_lm Q_(l-2)^m)  (l > m; Q_(m-1)^m = 0, a_(m+1)m = sqrt(2m + 3)),  a = sqrt((4l^2 - 1) / (l^2 - m^2)),
 //                                                   b = sqrt(((l-1)^2 - m^2) / (4 (l-1)^2 - 1)),
 //     Y_l0 = Q_l^0,  Y_lm = sqrt(2) Q_l^m Re (x + i y)^m,  Y_l(-m) = sqrt(2) Q_l^m Im (x + i y)^m.
 // Float throughout the lanes (the recurrence is stable for these B), double for the reductions.
@@ -51,7 +50,6 @@
 #if IBL_DETAIL_CXX20
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <memory>
@@ -148,13 +146,12 @@ template <class Lobe> int sh_rough_bands(double roughness, ld_weight weight, con
 struct sh_recurrence {
     int bands = 0;
     std::vector<float> a, b;    ///< a_lm, b_lm at l * bands + m (l >= m + 1)
-    std::vector<float> mm, m1;  ///< sqrt((2m + 1) / (2m)) (m >= 1), sqrt(2m + 3)
+    std::vector<float> mm;      ///< sqrt((2m + 1) / (2m)) (m >= 1)
     explicit sh_recurrence(int B = 0) : bands(B) {
         a.assign(std::size_t(B * B), 0.f), b.assign(std::size_t(B * B), 0.f);
-        mm.assign(std::size_t(std::max(B, 1)), 0.f), m1.assign(std::size_t(std::max(B, 1)), 0.f);
+        mm.assign(std::size_t(std::max(B, 1)), 0.f);
         for (int m = 0; m < B; ++m) {
             mm[std::size_t(m)] = m > 0 ? float(std::sqrt((2.0 * m + 1.0) / (2.0 * m))) : 1.f;
-            m1[std::size_t(m)] = float(std::sqrt(2.0 * m + 3.0));
             for (int l = m + 1; l < B; ++l) { // l = m + 1: a = sqrt(2m + 3), b = 0
                 const double L = l, M = m;
                 a[std::size_t(l * B + m)] = float(std::sqrt((4.0 * L * L - 1.0) / (L * L - M * M)));
@@ -163,37 +160,6 @@ struct sh_recurrence {
         }
     }
 };
-
-/// Calls visit(l, m, q, cr, ci) for every band l < B and order 0 <= m <= l of W unit directions:
-/// q = Q_l^m, cr + i ci = (x + i y)^m (lanes; header comment, "Basis"), m outer, l inner.
-template <std::size_t W, class Visit>
-inline void sh_lanes(const sh_recurrence& r, const float* x, const float* y, const float* z, Visit&& visit) {
-    const int B = r.bands;
-    float cr[W], ci[W], qmm[W], q1[W], q2[W], q[W];
-    for (std::size_t k = 0; k < W; ++k) cr[k] = 1.f, ci[k] = 0.f, qmm[k] = 0.28209479177387814f;
-    for (int m = 0; m < B; ++m) {
-        if (m > 0) {
-            const float f = r.mm[std::size_t(m)];
-            for (std::size_t k = 0; k < W; ++k) {
-                const float nr = cr[k] * x[k] - ci[k] * y[k], ni = cr[k] * y[k] + ci[k] * x[k];
-                cr[k] = nr, ci[k] = ni, qmm[k] *= f;
-            }
-        }
-        visit(m, m, static_cast<const float*>(qmm), static_cast<const float*>(cr), static_cast<const float*>(ci));
-        if (m + 1 >= B) break;
-        const float f1 = r.m1[std::size_t(m)];
-        for (std::size_t k = 0; k < W; ++k) q2[k] = qmm[k], q1[k] = f1 * z[k] * qmm[k];
-        visit(m + 1, m, static_cast<const float*>(q1), static_cast<const float*>(cr), static_cast<const float*>(ci));
-        for (int l = m + 2; l < B; ++l) {
-            const float a = r.a[std::size_t(l * B + m)], b = r.b[std::size_t(l * B + m)];
-            for (std::size_t k = 0; k < W; ++k) {
-                q[k] = a * (z[k] * q1[k] - b * q2[k]);
-                q2[k] = q1[k], q1[k] = q[k];
-            }
-            visit(l, m, static_cast<const float*>(q), static_cast<const float*>(cr), static_cast<const float*>(ci));
-        }
-    }
-}
 
 /// Index of (l, m) in the B^2 coefficients (l * l + l + m, as sh/basis.hpp).
 constexpr std::size_t sh_index(int l, int m) noexcept { return std::size_t(l * l + l + m); }
