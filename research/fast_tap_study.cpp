@@ -45,16 +45,14 @@
 #include <ibl/reference/ld_irradiance.hpp>
 #include <ibl/reference/radiance.hpp>
 
-#include "io/image_io.hpp"
+#include "ld_study.hpp"
 
 using ibl::vec3;
 using dvec3 = ibl::vec3<double>;
+using ld_study::lum;
+using ld_study::texel_ref;
 
 namespace {
-double unit(std::uint32_t a, std::uint32_t b) {
-    return double(ibl::detail::rr_hash(ibl::detail::rr_hash(a * 0x9e3779b9u + 17u) ^ b) >> 8) * 0x1p-24;
-}
-double lum(const dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 double cdf_at_theta(const ibl::detail::fast_radial_cdf& c, double t) {
     auto it = std::lower_bound(c.theta.begin(), c.theta.end(), t);
@@ -64,11 +62,6 @@ double cdf_at_theta(const ibl::detail::fast_radial_cdf& c, double t) {
     const double f = (t - c.theta[i - 1]) / (c.theta[i] - c.theta[i - 1]);
     return c.cdf[i - 1] + f * (c.cdf[i] - c.cdf[i - 1]);
 }
-
-struct texel_ref {
-    int f, x, y;
-    dvec3 ref;
-};
 
 // Polar grid: a centre disk of radius theta0, then bands growing by rho up to pi/2, each of
 // m = round(2 pi theta_mid / width x aspect) cells with its tap at the band's mass-median radius.
@@ -137,13 +130,7 @@ ibl::sphere_sample_table<float> spiral_table(const ibl::cubemap<float>& cube, co
 }
 
 double rel_rmse(const std::vector<vec3<float>>& tex, int n, const std::vector<texel_ref>& refs) {
-    double s = 0;
-    for (const texel_ref& r : refs) {
-        const dvec3 v(tex[ibl::cube_texel_index(r.f, r.x, r.y, n)]);
-        const double a = lum(v), b = lum(r.ref);
-        s += (a - b) * (a - b) / (b * b);
-    }
-    return std::sqrt(s / double(refs.size()));
+    return ld_study::rel_rmse(refs, [&](int f, int x, int y) { return tex[ibl::cube_texel_index(f, x, y, n)]; });
 }
 struct design {
     std::string name;
@@ -242,17 +229,9 @@ chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const 
 } // namespace
 
 int main(int argc, char** argv) {
-    int texels = 400;
-    std::vector<std::string> files;
-    bool quick = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--texels" && i + 1 < argc) texels = std::max(16, std::atoi(argv[++i]));
-        else if (a == "--quick") quick = true;
-        else files.push_back(a);
-    }
-    if (files.empty()) files = {std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr", std::string(IBL_RESEARCH_DATA_DIR) + "/studio.exr"};
-    if (quick) files.resize(1), texels = 32;
+    const ld_study::args args = ld_study::parse(argc, argv);
+    const int texels = args.texels;
+    const bool quick = args.quick;
     const ibl::ld_weight w = ibl::ld_weight::n_dot_l;
     std::vector<design> designs;
     if (!quick) designs.push_back({"fis default (512, trilinear)", [&](const ibl::cubemap<float>& c, int l, double r) {
@@ -290,30 +269,19 @@ int main(int argc, char** argv) {
                            }});
     }
     ibl::thread_executor ex{2};
-    for (const std::string& file : files) {
-        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file, {});
-        ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);
-        map.update_borders();
-        const int k = std::max(2, int(std::ceil(double(img.width) / (4.0 * base_size))));
-        const ibl::cubemap<float> cube = ibl::bake_cubemap<float>(map, base_size, k, ex, 0);
+    for (const std::string& file : args.files) {
+        const ibl::latlong<float> map = ld_study::load_latlong(file);
+        const ibl::cubemap<float> cube = ld_study::source_cube(map, base_size, ex);
         std::vector<std::vector<texel_ref>> refs(chain_levels);
         // Per level: the old check's references (reference_ld at 2048 and 8192 samples on the
         // lat-long map) and ld_texel_sum at ld_texel_sum_level against the exact texel sum at level 0.
         std::vector<std::array<double, 3>> floor(chain_levels);
         std::vector<int> sum_level(chain_levels, 0);
         for (int l = 1; l < chain_levels; ++l) {
-            const int n = base_size >> l;
             const double r = level_r(l);
             auto& rl = refs[std::size_t(l)];
-            rl.resize(std::size_t(texels));
-            std::vector<dvec3> dirs(rl.size());
-            for (std::size_t i = 0; i < rl.size(); ++i) {
-                texel_ref& t = rl[i];
-                t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
-                t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
-                t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
-                dirs[i] = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
-            }
+            rl = ld_study::level_texels(l, base_size >> l, texels);
+            const std::vector<dvec3> dirs = ld_study::directions(rl);
             const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), r, w, ex);
             sum_level[std::size_t(l)] = ibl::ld_texel_sum_level(cube, r);
             const std::vector<dvec3> coarse = ibl::ld_texel_sum(cube, sum_level[std::size_t(l)], std::span<const dvec3>(dirs), r, w, ex);

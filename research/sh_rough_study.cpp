@@ -26,20 +26,15 @@
 
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/core/executor.hpp>
-#include <ibl/env/convert.hpp>
-#include <ibl/env/latlong.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
-#include <ibl/reference/radiance.hpp>
 
-#include "io/image_io.hpp"
+#include "ld_study.hpp"
 
 using dvec3 = ibl::vec3<double>;
+using ld_study::lum;
+using ld_study::texel_ref;
 
 namespace {
-double unit(std::uint32_t a, std::uint32_t b) {
-    return double(ibl::detail::rr_hash(ibl::detail::rr_hash(a * 0x9e3779b9u + 17u) ^ b) >> 8) * 0x1p-24;
-}
-double lum(const dvec3& c) { return 0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z; }
 
 /// Real orthonormal SH of bands 0..B-1 at the unit direction d (zonal about +Z, no Condon-Shortley
 /// phase), index l*l + l + m: the normalised associated Legendre recurrence in z times
@@ -74,51 +69,27 @@ void sh_eval(int B, const dvec3& d, double* y) {
     }
 }
 
-struct texel_ref {
-    int f, x, y;
-    dvec3 dir, ref;
-};
 constexpr int chain_levels = 6;
 constexpr int base_size = 256;
 double level_r(int l) { return double(l) / double(chain_levels - 1); }
 } // namespace
 
 int main(int argc, char** argv) {
-    int texels = 400;
-    std::vector<std::string> files;
-    bool quick = false;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        if (a == "--texels" && i + 1 < argc) texels = std::max(16, std::atoi(argv[++i]));
-        else if (a == "--quick") quick = true;
-        else files.push_back(a);
-    }
-    if (files.empty()) files = {std::string(IBL_RESEARCH_DATA_DIR) + "/courtyard.exr", std::string(IBL_RESEARCH_DATA_DIR) + "/studio.exr"};
-    if (quick) files.resize(1), texels = 32;
+    const ld_study::args args = ld_study::parse(argc, argv);
+    const int texels = args.texels;
+    const bool quick = args.quick;
     const ibl::ld_weight w = ibl::ld_weight::n_dot_l;
     const std::vector<int> bands = quick ? std::vector<int>{8} : std::vector<int>{6, 8, 10, 12, 16, 20, 24, 32};
     const int max_b = *std::max_element(bands.begin(), bands.end());
     ibl::thread_executor ex{2};
     int bad = 0;
-    for (const std::string& file : files) {
-        const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file, {});
-        ibl::latlong<float> map(img.width, img.height, std::span<const float>(img.rgb), 1);
-        map.update_borders();
-        const int k = std::max(2, int(std::ceil(double(img.width) / (4.0 * base_size))));
-        const ibl::cubemap<float> cube = ibl::bake_cubemap<float>(map, base_size, k, ex, 0);
+    for (const std::string& file : args.files) {
+        const ibl::cubemap<float> cube = ld_study::source_cube(ld_study::load_latlong(file), base_size, ex);
         std::vector<std::vector<texel_ref>> refs(chain_levels);
         for (int l = 1; l < chain_levels; ++l) {
-            const int n = base_size >> l;
             auto& rl = refs[std::size_t(l)];
-            rl.resize(std::size_t(texels));
-            std::vector<dvec3> dirs(rl.size());
-            for (std::size_t i = 0; i < rl.size(); ++i) {
-                texel_ref& t = rl[i];
-                t.f = int(unit(std::uint32_t(i), 1 + 7 * l) * 6);
-                t.x = int(unit(std::uint32_t(i), 2 + 7 * l) * n);
-                t.y = int(unit(std::uint32_t(i), 3 + 7 * l) * n);
-                t.dir = dirs[i] = ibl::cube_texel_direction<double>(t.f, t.x, t.y, n);
-            }
+            rl = ld_study::level_texels(l, base_size >> l, texels);
+            const std::vector<dvec3> dirs = ld_study::directions(rl);
             const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), level_r(l), w, ex);
             for (std::size_t i = 0; i < rl.size(); ++i) rl[i].ref = exact[i];
         }
@@ -149,13 +120,7 @@ int main(int argc, char** argv) {
                 }
                 std::printf("| %u x 4^(l-1) samples | %s |", n0, b.c_str());
                 for (int l = 1; l < chain_levels; ++l) {
-                    double s2 = 0;
-                    for (const texel_ref& t : refs[std::size_t(l)]) {
-                        const dvec3 v(ch.texel(t.f, t.x, t.y, l));
-                        const double a = lum(v), bb = lum(t.ref);
-                        s2 += (a - bb) * (a - bb) / (bb * bb);
-                    }
-                    const double e = std::sqrt(s2 / double(refs[std::size_t(l)].size()));
+                    const double e = ld_study::rel_rmse(refs[std::size_t(l)], [&](int f, int x, int y) { return ch.texel(f, x, y, l); });
                     bad += std::isfinite(e) ? 0 : 1;
                     err[std::size_t(sh)][std::size_t(l)] = e;
                     std::printf(" %.3g", e);
