@@ -14,6 +14,7 @@
 
 #include <ibl/bake/prefilter.hpp>
 #include <ibl/bake/prefilter_peaks.hpp>
+#include <ibl/bake/prefilter_sh.hpp>
 #include <ibl/env/analytic.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/cube_geometry.hpp>
@@ -886,7 +887,9 @@ void print_fixtures() {
 /// in front of a row, the GPU's plain sum) its single-level taps as the kernel runs them
 /// (make_ld_table_for + detail::make_taps), its merged peaks as the row kernel adds them
 /// (make_peak_level: direction and pre-scaled energy, a2, the weight; 4 peaks at level 1, merged to
-/// 2 from level 2) and the chain's texels (face, row, column) the GLSL must reproduce.
+/// 2 from level 2), its spherical-harmonic texture when the level is reconstructed from the split's
+/// base's projection (prefilter_options::sh_rough, on by default: ibl_prefilter_sh's coefficients,
+/// norm and recurrence constants) and the chain's texels (face, row, column) the GLSL must reproduce.
 void print_prefilter_fixtures() {
     constexpr int size = 64, width = 256;
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
@@ -894,7 +897,6 @@ void print_prefilter_fixtures() {
     o.method = ibl::prefilter_method::fast;
     o.peaks.enabled = true;
     o.peaks.cut = 0.0; // every peak in front of some texel of a row: the GLSL's plain sum over the list
-    o.sh_rough.enabled = false; // the GPU filter runs the tap sets on every level (bake/prefilter_sh.hpp is CPU only)
     // What prefilter's cubemap source holds (detail::prefilter_cube_source): the split's base packed
     // when there are peaks, else the source.
     const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(src, o.peaks, ibl::serial_executor{});
@@ -920,12 +922,24 @@ void print_prefilter_fixtures() {
         o.weight = weight;
         const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::serial_executor{});
         const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(o, size);
+        // The levels by spherical harmonics (bake/prefilter_sh.hpp): the split's base projected as
+        // prefilter_cube_source::sh_project does, onto the plan's most bands.
+        const int max_bands = ibl::detail::prefilter_sh_max_bands<ibl::ggx_lobe>(o, plan);
+        ibl::detail::sh_projection proj;
+        std::vector<double> coefs, unit;
+        if (max_bands > 0) {
+            const int pl = ibl::detail::sh_projection_level(packed, max_bands);
+            proj = ibl::detail::sh_projection(max_bands, pl, packed.levels[std::size_t(pl)].n);
+            for (std::size_t row = 0; row < proj.rows(); ++row) proj.add_row(packed, row);
+            coefs = proj.coefficients();
+            unit = *ibl::detail::sh_unit_coefficients(proj);
+        }
         for (std::size_t l = 0; l < plan.size(); ++l) {
             const ibl::prefilter_level& lp = plan[l];
             if (lp.level == 0) continue; // the mirror level is a copy
             // The coarse tail (prefilter_options::coarse_tail): the rest kernel's taps and the share of
             // the next level (the GPU reads its own next level before its peaks, as the C++ does).
-            const double rn = ibl::detail::prefilter_tail_roughness<ibl::ggx_lobe>(o, plan, l, size);
+            const double rn = ibl::detail::prefilter_tail_roughness<ibl::ggx_lobe>(o, plan, l, size, true);
             const ibl::detail::fast_coarse_tail tail =
                 rn >= 0.0 ? ibl::detail::fast_tail_of<ibl::ggx_lobe>(lp.roughness, rn, o.weight) : ibl::detail::fast_coarse_tail{};
             ibl::sphere_sample_table<float> table =
@@ -956,7 +970,38 @@ void print_prefilter_fixtures() {
                         "\"next_n\": %d",
                         pl.size(), double(pl.a2), pl.g1 ? "true" : "false", rn, double(float(tail.share)),
                         l + 1 < plan.size() ? chain.size(int(l) + 1) : 0);
-            std::printf(", \"peaks\": [");
+            // A level by spherical harmonics: ibl_prefilter_sh's texture (pairs x 3 texels, row by row).
+            const int bands = ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(o, lp);
+            std::printf(", \"sh_bands\": %d, \"projection_bands\": %d, \"projection_face\": %d, \"sh\": [", bands, max_bands,
+                        max_bands > 0 ? proj.face_size() : 0);
+            if (bands > 0) {
+                ibl::detail::sh_level sl, su;
+                sl.bands = su.bands = bands;
+                sl.rec = su.rec = ibl::detail::sh_recurrence(bands);
+                const auto k = ibl::detail::lobe_band_factors<ibl::ggx_lobe>(lp.roughness, o.weight);
+                sl.k.assign(k->begin(), k->begin() + bands);
+                su.k = sl.k;
+                sl.set_coefficients(coefs, max_bands);
+                su.set_coefficients(unit, max_bands);
+                const std::size_t pairs = ibl::detail::sh_pair_count(bands);
+                std::vector<float> tex(pairs * 12, 0.f);
+                std::size_t p = 0;
+                for (int m = 0; m < bands; ++m)
+                    for (int j = m; j < bands; ++j, ++p) {
+                        for (std::size_t c = 0; c < 3; ++c) {
+                            tex[4 * p + c] = sl.coef[6 * p + c];
+                            tex[4 * (pairs + p) + c] = sl.coef[6 * p + 3 + c];
+                        }
+                        tex[4 * p + 3] = su.coef[6 * p];
+                        tex[4 * (pairs + p) + 3] = su.coef[6 * p + 3];
+                        const std::size_t r = 4 * (2 * pairs + p);
+                        tex[r] = j > m ? sl.rec.a[std::size_t(j * bands + m)] : 1.f;
+                        tex[r + 1] = j > m ? sl.rec.b[std::size_t(j * bands + m)] : 0.f;
+                        tex[r + 2] = sl.rec.mm[std::size_t(m)];
+                    }
+                for (std::size_t i = 0; i < tex.size(); ++i) std::printf("%s%.9g", i ? ", " : "", double(tex[i]));
+            }
+            std::printf("], \"peaks\": [");
             for (std::size_t j = 0; j < pl.size(); ++j)
                 std::printf("%s%.9g, %.9g, %.9g, %.9g, %.9g, %.9g", j ? ", " : "", double(pl.px[j]), double(pl.py[j]),
                             double(pl.pz[j]), double(pl.er[j]), double(pl.eg[j]), double(pl.eb[j]));

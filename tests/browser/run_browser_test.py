@@ -18,11 +18,17 @@ SwiftShader's WebGL2), compared with the C++.
   prefilter  lets tools/viewer/prefilter.frag.glsl (include/ibl/glsl/ibl_prefilter.glsl) filter the
            fixtures' source (`glsl_reference --prefilter-fixtures`: the default sky at 64^2 split by
            the peak split, its base packed, and per LD weight and level the fast filter's taps and
-           merged peaks) and compares every texel of every convolved level with the C++ chain
+           merged peaks, or the level's spherical-harmonic coefficients where the C++ default
+           reconstructs it from them) and compares every texel of every convolved level with the C++ chain
            (ibl::prefilter, method fast, peaks.cut = 0) within half-float rounding: |GLSL - C++|
            <= 2^-11 |C++| per value. Then the viewer's own inputs (tools/viewer/refilter.js: the
-           split, the base's packing, the taps, the peak lists) against the C++ ones, and the
+           split, the base's packing, the taps, the peak lists, the band choice and projection) against the C++ ones, and the
            levels rendered from them against the C++ chain (1e-4 relative).
+  refilter bakes the built-in sky with the fast filter into a float chain (--size N --prefilter
+           fast --ktx2-format rgba32f; ctest: N = 64) and lets the viewer re-filter it live (Renderer.refilter,
+           the viewer's button: refilter.js and ibl_prefilter.glsl from the chain's level 0); every
+           re-filtered level against the chain ibl-bake wrote, within 2e-3 relative (the C++'s
+           peak row cut is 1e-3).
   bc6h     the browser's own BC6H decoder against the library's: the page uploads the blocks that
            `bc6h_fixtures` prints (random blocks of every mode code, reserved ones included, and
            blocks ibl::bc6h_encode_image made of HDR content) as one EXT_texture_compression_bptc
@@ -570,7 +576,8 @@ def compare_prefilter(fixtures, result):
                     print(f"  {name} value {i}: GLSL {g!r} C++ {e!r}")
                 bad += 1
         tail = f", coarse tail {lv['tail_share']:.4g} of the {lv['next_n']}^2 next level" if lv.get("tail_share", 0) > 0 else ""
-        print(f"{name} ({lv['n']}^2 x 6, {lv['count']} taps, {lv['peak_count']} peaks{tail}): worst |diff| / (2^-11 |C++|) "
+        how = f"{lv['sh_bands']} SH bands" if lv.get("sh_bands", 0) > 0 else f"{lv['count']} taps"
+        print(f"{name} ({lv['n']}^2 x 6, {how}, {lv['peak_count']} peaks{tail}): worst |diff| / (2^-11 |C++|) "
               f"{worst:.3g}, {bad} values outside")
         ok = ok and bad == 0
     # The viewer's live path (tools/viewer/refilter.js): its packing and taps against the C++ ones,
@@ -597,12 +604,49 @@ def compare_prefilter(fixtures, result):
         print(f"viewer peaks, level {lv['level']} ({lv['weight']}): {d} (C++ {lv['peak_count']} peaks)")
         ok = ok and d.get("count") == lv["peak_count"] and "dir_max_abs" in d and d["dir_max_abs"] <= 1e-6 and \
             d["energy_max_rel"] <= 1e-5 and abs(d["a2"] - d["expected_a2"]) <= 1e-7 * d["expected_a2"]
+    # The levels by spherical harmonics (refilter.js shBands, shProject, shLevel) against the C++'s
+    # (sh_rough_bands, sh_projection in float lanes, sh_level::set_coefficients): the same bands and
+    # projected face, coefficients within 1e-5 of their row's largest, the recurrence's constants
+    # to float rounding.
+    for lv, d in zip(fixtures["levels"], result["sh"]):
+        print(f"viewer sh, level {lv['level']} ({lv['weight']}): {d}")
+        ok = ok and d.get("bands") == lv["sh_bands"]
+        if lv["sh_bands"] > 0:
+            ok = ok and d.get("face") == lv["projection_face"] and d.get("cosine_max_rel", 1) <= 1e-5 and \
+                d.get("sine_max_rel", 1) <= 1e-5 and d.get("recurrence_max_rel", 1) <= 1e-7
     by_level = {(lv["level"], lv["weight"]): lv for lv in result["js_levels"]}
     for lv in fixtures["levels"]:
         got = by_level.get((lv["level"], lv["weight"]))
         worst = max(abs(g - e) / max(abs(e), 1e-30) for e, g in zip(lv["expect"], got["rgb"])) if got else float("inf")
         print(f"viewer re-filter, level {lv['level']} ({lv['weight']}): worst relative difference from ibl::prefilter {worst:.3g}")
         ok = ok and worst <= 1e-4
+    print(f"renderer: {result.get('renderer')}")
+    print("PASS" if ok else "FAIL")
+    return ok
+
+
+def compare_refilter(result, rel=2e-3):
+    """The viewer's live re-filter (Renderer.refilter: refilter.js and ibl_prefilter.glsl on the
+    chain's level 0) against the chain ibl-bake wrote (ibl::prefilter, the fast filter): every value
+    within `rel` of the C++'s, relative to max(|C++|, 1e-3 of the level's mean). The differences
+    are the peak split's row cut (prefilter peaks.cut = 1e-3: the C++ skips the peaks that change no
+    texel of a row by more than 1e-3 relative; the GPU adds every peak) and float rounding."""
+    ok = bool(result["levels"])
+    t = result["timing"]
+    print(f"re-filter: {t['levels']} levels, {t['peaks']} peaks: {t['gpu_ms']:.1f} ms GPU + {t['prepare_ms']:.1f} ms CPU")
+    for lv in result["levels"]:
+        cpp, gpu = lv["cpp"], lv["gpu"]
+        mean = sum(abs(v) for v in cpp) / max(1, len(cpp))
+        floor = 1e-3 * mean
+        worst, sq, bad = 0.0, 0.0, 0
+        for e, g in zip(cpp, gpu):
+            d = abs(g - e) / max(abs(e), floor)
+            worst = max(worst, d)
+            sq += d * d
+            bad += 0 if d <= rel else 1
+        rms = (sq / max(1, len(cpp))) ** 0.5
+        print(f"level {lv['level']} ({lv['n']}^2 x 6): worst relative difference {worst:.3g}, rms {rms:.3g}, {bad} values above {rel:g}")
+        ok = ok and len(cpp) == len(gpu) == 18 * lv["n"] ** 2 and bad == 0
     print(f"renderer: {result.get('renderer')}")
     print("PASS" if ok else "FAIL")
     return ok
@@ -761,7 +805,7 @@ def compare_bc6h(fixtures, result):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "bc6h", "room", "screenshot"], required=True)
+    ap.add_argument("--mode", choices=["preview", "numeric", "prefilter", "refilter", "bc6h", "room", "screenshot"], required=True)
     ap.add_argument("--page", choices=["viewer", "room"], default="viewer", help="screenshot: which page")
     ap.add_argument("--tool", help="ibl-bake (preview)")
     ap.add_argument("--reference", help="glsl_reference (numeric, prefilter), bc6h_fixtures (bc6h), room_reference (room)")
@@ -781,6 +825,9 @@ def main():
     try:
         bake_dir = os.path.join(work, "bake")
         os.makedirs(bake_dir)
+        if a.mode == "refilter":  # a fast-filter bake with a float chain: the viewer re-filters it live
+            subprocess.run([a.tool, "--size", a.size, "--prefilter", "fast", "--ktx2-format", "rgba32f", "--out", bake_dir,
+                            "--quiet"] + a.bake_args.split(), check=True, stdout=subprocess.DEVNULL)
         if a.mode in ("preview", "screenshot") and a.page == "viewer":
             subprocess.run([a.tool, "--size", a.size, "--quality", a.quality, "--out", bake_dir, "--quiet"] +
                            (["--input", a.input] if a.input else []) + a.bake_args.split(), check=True,
@@ -839,6 +886,8 @@ def main():
                 open(os.path.join(a.keep, "browser_rgb.bin"), "wb").write(base64.b64decode(result["rgb"]))
         elif a.mode == "prefilter":
             ok = compare_prefilter(json.loads(prefilter_fixtures), result)
+        elif a.mode == "refilter":
+            ok = compare_refilter(result)
         elif a.mode == "room":
             ok = compare_room(json.loads(room_fixtures), result, ROOM_REL, ROOM_ABS)
         elif a.mode == "bc6h":

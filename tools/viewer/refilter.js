@@ -384,3 +384,136 @@ export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = 
     });
     return { peak_count: merged.length, peaks: out, a2: Math.fround(a2), g1: weight === 'g1' };
 }
+
+// ---- the rough levels by spherical harmonics (include/ibl/bake/prefilter_sh.hpp) ---------------
+
+/// sh_rough_options' defaults (the C++ prefilter's).
+export const shDefaults = { maxBands: 24, tolerance: 5e-4 };
+
+/// The n-point Gauss-Legendre rule on [-1, 1] (core/gauss_legendre.hpp make_gauss_legendre_symmetric).
+function gaussLegendre(n) {
+    const x = new Float64Array(n), w = new Float64Array(n);
+    const legendre = (t) => { // P_n(t) and its derivative
+        let p0 = 1, p1 = t;
+        for (let k = 2; k <= n; ++k) { const p2 = ((2 * k - 1) * t * p1 - (k - 1) * p0) / k; p0 = p1; p1 = p2; }
+        return [n === 0 ? 1 : p1, n * (t * p1 - p0) / (t * t - 1)];
+    };
+    for (let i = 0; i < (n + 1) >> 1; ++i) {
+        let t = Math.cos(Math.PI * (i + 0.75) / (n + 0.5));
+        for (let it = 0; it < 100; ++it) {
+            const [p, dp] = legendre(t), dt = p / dp;
+            t -= dt;
+            if (Math.abs(dt) <= 4 * Number.EPSILON) break;
+        }
+        const dp = legendre(t)[1];
+        x[n - 1 - i] = t, x[i] = -t;
+        w[i] = w[n - 1 - i] = 2 / ((1 - t) * (1 + t) * dp * dp);
+    }
+    if (n % 2 === 1) x[n >> 1] = 0;
+    return { x, w };
+}
+
+/// k_l, l < count, of the LD kernel normalised to k_0 = 1 (detail::zonal_band_factors: 24-node
+/// Gauss-Legendre on panels in theta growing by 1.4 from a fiftieth of the lobe's scale to pi / 2).
+export function bandFactors(roughness, weight, count = 97) {
+    const r = Math.min(1, Math.max(0, Number.isFinite(roughness) ? roughness : 0));
+    const k = new Float64Array(Math.max(count, 1)), gl = gaussLegendre(24), halfPi = 0.5 * Math.PI;
+    const s = Math.max(1e-4, 2 * Math.atan(Math.max(r * r, 1e-3)));
+    const edges = [0];
+    for (let t = 0.02 * s; t < halfPi; t *= 1.4) edges.push(t);
+    edges.push(halfPi);
+    for (let e = 0; e + 1 < edges.length; ++e) {
+        const a = edges[e], b = edges[e + 1];
+        for (let i = 0; i < gl.x.length; ++i) {
+            const t = 0.5 * (a + b) + 0.5 * (b - a) * gl.x[i];
+            const f = kernel(t, r, weight) * Math.sin(t) * 0.5 * (b - a) * gl.w[i], mu = Math.cos(t);
+            let p0 = 1, p1 = mu;
+            for (let l = 0; l < k.length; ++l) {
+                k[l] += f * p0;
+                const p2 = ((2 * l + 3) * mu * p1 - (l + 1) * p0) / (l + 2);
+                p0 = p1, p1 = p2;
+            }
+        }
+    }
+    const k0 = k[0];
+    return k.map((v) => (k0 > 0 ? v / k0 : 0));
+}
+
+/// The bands a level of roughness r needs (detail::sh_rough_bands: the fewest B whose truncation
+/// error on band powers (l + 1)^-2 is at most the tolerance), or 0 when more than maxBands.
+export function shBands(roughness, weight, opt = shDefaults) {
+    const k = bandFactors(roughness, weight), tail = new Float64Array(k.length + 1);
+    for (let l = k.length; l-- > 0;) tail[l] = tail[l + 1] + (2 * l + 1) * k[l] * k[l] / ((l + 1) * (l + 1));
+    for (let b = 1; b <= Math.min(opt.maxBands, 32); ++b) if (Math.sqrt(tail[b] / tail[0]) <= opt.tolerance) return b;
+    return 0;
+}
+
+/// Index of pair (l, m) in the kernels' order for B bands (m outer, l = m .. B - 1 inner).
+const pairIndex = (B, l, m) => m * B - (m * (m - 1)) / 2 + (l - m);
+
+/// The projection of packSource's packing onto B bands (detail::sh_projection on the level
+/// sh_projection_level picks: the finest whose face is at most max(16, 2 B)): per pair the cosine
+/// and sine sums of R G B over the texels (radiance x exact solid angle x Q_l^m Re / Im (x + i y)^m),
+/// and the same of a constant 1 (the norm's). In double. { bands, face, coef, unit } (6 per pair).
+export function shProject(packed, bands) {
+    const cap = Math.max(16, 2 * bands);
+    let lv = packed.levels[packed.levels.length - 1];
+    for (const l of packed.levels) if (l.n <= cap) { lv = l; break; }
+    const n = lv.n, pairs = (bands * (bands + 1)) / 2;
+    const coef = new Float64Array(6 * pairs), unit = new Float64Array(6 * pairs);
+    const mm = Array.from({ length: bands }, (_, m) => (m > 0 ? Math.sqrt((2 * m + 1) / (2 * m)) : 1));
+    const q = new Float64Array(bands);
+    for (let f = 0; f < 6; ++f)
+        for (let y = 0; y < n; ++y)
+            for (let x = 0; x < n; ++x) {
+                const d = facePoint(f, 2 * ((x + 0.5) / n) - 1, 2 * ((y + 0.5) / n) - 1), len = Math.hypot(d[0], d[1], d[2]);
+                const dx = d[0] / len, dy = d[1] / len, dz = d[2] / len, om = texelSolidAngle(x, y, n);
+                const at = 4 * (lv.offset + f * lv.faceStride + (y + 1) * lv.stride + (x + 1));
+                const w = [om * packed.data[at], om * packed.data[at + 1], om * packed.data[at + 2]];
+                let cr = 1, ci = 0, qmm = 0.28209479177387814;
+                for (let m = 0; m < bands; ++m) {
+                    if (m > 0) {
+                        const nr = cr * dx - ci * dy, ni = cr * dy + ci * dx;
+                        cr = nr, ci = ni, qmm *= mm[m];
+                    }
+                    q[m] = qmm;
+                    for (let l = m + 1; l < bands; ++l) {
+                        const L = l, M = m, a = Math.sqrt((4 * L * L - 1) / (L * L - M * M));
+                        const b = l > m + 1 ? Math.sqrt(((L - 1) * (L - 1) - M * M) / (4 * (L - 1) * (L - 1) - 1)) : 0;
+                        q[l] = a * (dz * q[l - 1] - (l > m + 1 ? b * q[l - 2] : 0));
+                    }
+                    for (let l = m; l < bands; ++l) {
+                        const p = 6 * pairIndex(bands, l, m), c = q[l] * cr, s = q[l] * ci;
+                        for (let ch = 0; ch < 3; ++ch) coef[p + ch] += c * w[ch], coef[p + 3 + ch] += s * w[ch];
+                        unit[p] += c * om, unit[p + 3] += s * om;
+                    }
+                }
+            }
+    for (let p = 0; p < pairs; ++p) unit[6 * p + 1] = unit[6 * p + 2] = unit[6 * p], unit[6 * p + 4] = unit[6 * p + 5] = unit[6 * p + 3];
+    return { bands, face: n, coef, unit };
+}
+
+/// A level's texture for ibl_prefilter_sh (sh_pair_count(B) x 3 texels, row by row): its B bands'
+/// k_l (times 2 for m > 0: the basis's sqrt(2) in the projection and in the reconstruction) times
+/// the projection's cosine and sine sums (R G B, the norm's in alpha), then the recurrence's
+/// constants (a_lm, b_lm, sqrt((2m + 1) / (2m)), 0). { sh_bands, sh } (sh_bands 0: the level keeps its taps).
+export function shLevel(proj, roughness, weight, bands) {
+    if (!(bands > 0) || !proj || proj.bands < bands) return { sh_bands: 0, sh: new Float32Array(0) };
+    const k = bandFactors(roughness, weight), pairs = (bands * (bands + 1)) / 2, tex = new Float32Array(12 * pairs);
+    let p = 0;
+    for (let m = 0; m < bands; ++m)
+        for (let l = m; l < bands; ++l, ++p) {
+            const g = k[l] * (m > 0 ? 2 : 1), pp = 6 * pairIndex(proj.bands, l, m);
+            for (let c = 0; c < 3; ++c) {
+                tex[4 * p + c] = g * proj.coef[pp + c];
+                tex[4 * (pairs + p) + c] = g * proj.coef[pp + 3 + c];
+            }
+            tex[4 * p + 3] = g * proj.unit[pp];
+            tex[4 * (pairs + p) + 3] = g * proj.unit[pp + 3];
+            const L = l, M = m, r = 4 * (2 * pairs + p);
+            tex[r] = l > m ? Math.sqrt((4 * L * L - 1) / (L * L - M * M)) : 1;
+            tex[r + 1] = l > m ? Math.sqrt(((L - 1) * (L - 1) - M * M) / (4 * (L - 1) * (L - 1) - 1)) : 0;
+            tex[r + 2] = m > 0 ? Math.sqrt((2 * m + 1) / (2 * m)) : 1;
+        }
+    return { sh_bands: bands, sh: tex };
+}

@@ -7,6 +7,8 @@
 //   test=preview render ibl-bake's preview.png exactly (640 x 256) and POST the pixels to `report`
 //   test=numeric evaluate the GLSL functions on fixed inputs (numeric.frag.glsl) and POST them
 //   test=prefilter filter the fixtures' sky with ibl_prefilter.glsl and POST every texel
+//   test=refilter re-filter the bake's chain live (Renderer.refilter) and POST every level as
+//                loaded (the C++ chain) and as re-filtered (read back from the chain texture)
 //   test=bc6h    read every texel of the BC6H fixtures' blocks through EXT_texture_compression_bptc
 //                and POST them (tests/browser/run_browser_test.py --mode bc6h compares them)
 //   report=URL   where a test POSTs its JSON result (tests/browser/run_browser_test.py serves it)
@@ -31,7 +33,7 @@
 // for Zstandard-supercompressed files (--ktx2-zstd N), the panel says so and nothing is drawn.
 
 import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
-import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel } from './refilter.js';
+import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel, shBands, shProject, shLevel } from './refilter.js';
 
 const params = new URLSearchParams(location.search);
 const testMode = params.get('test');
@@ -316,7 +318,9 @@ function packedTexture(gl, data, width, unit = 0) {
 /// its peaks on unit 3 (a 1 x 2 zero texture without), and with { tail_share > 0, next } the coarse
 /// tail: next() (called when the level's turn comes, after the earlier levels' done) returns
 /// { n, data } the next level before its peaks (the shader's second output) packed with its border
-/// (refilter.js packSource(n, rgbOf, null, 1)), uploaded on unit 4. target(level, face) binds the
+/// (refilter.js packSource(n, rgbOf, null, 1)), uploaded on unit 4, and with { sh_bands > 0, sh }
+/// (refilter.js shLevel: sh_pair_count x 3 texels) the level reconstructed from its spherical
+/// harmonics instead of its taps, the texture on unit 6. target(level, face) binds the
 /// framebuffer's attachments before a pass (the second, when bound, receives the texel before its
 /// peaks), done(level, face) runs after it. Returns the textures it made (the caller deletes them).
 function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
@@ -327,6 +331,7 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     gl.uniform1i(u('u_taps'), 1);
     gl.uniform1i(u('u_peaks'), 3);
     gl.uniform1i(u('u_next'), 4);
+    gl.uniform1i(u('u_sh'), 6);
     const made = [];
     for (const lv of levels) {
         const share = lv.tail_share > 0 ? lv.tail_share : 0;
@@ -334,10 +339,10 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
         made.push(packedTexture(gl, next.data, 256, 4));
         gl.uniform1i(u('u_next_n'), next.n);
         gl.uniform1f(u('u_tail_share'), share);
-        const both = new Float32Array(8 * lv.count);
+        const width = Math.max(1, lv.count), both = new Float32Array(8 * width); // a level by SH may have no taps
         both.set(lv.taps);
-        both.set(lv.info, 4 * lv.count);
-        made.push(floatTexture(gl, 1, lv.count, 2, both));
+        both.set(lv.info, 4 * width);
+        made.push(floatTexture(gl, 1, width, 2, both));
         const np = lv.peak_count || 0, peaks = new Float32Array(8 * Math.max(1, np));
         for (let j = 0; j < np; ++j)
             for (let c = 0; c < 3; ++c) {
@@ -348,6 +353,10 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
         gl.uniform1i(u('u_peak_count'), np);
         gl.uniform1f(u('u_peak_a2'), np ? lv.a2 : 0);
         gl.uniform1i(u('u_peak_g1'), np && lv.g1 ? 1 : 0);
+        const bands = lv.sh_bands > 0 ? lv.sh_bands : 0;
+        if (bands > 0 && lv.sh.length !== 12 * (bands * (bands + 1) / 2)) throw new Error(`level ${lv.level}: sh texture of the wrong size`);
+        made.push(bands > 0 ? floatTexture(gl, 6, bands * (bands + 1) / 2, 3, Float32Array.from(lv.sh)) : floatTexture(gl, 6, 1, 3, new Float32Array(12)));
+        gl.uniform1i(u('u_sh_bands'), bands);
         gl.uniform1i(u('u_count'), lv.count);
         gl.uniform1f(u('u_factor'), lv.factor);
         gl.uniform1i(u('u_n'), lv.n);
@@ -415,8 +424,10 @@ class Renderer {
     /// Re-filters the loaded chain's levels >= 1 from its level 0 on the GPU with the fast filter
     /// (ibl_prefilter.glsl: refilter.js splits level 0's peaks off as the C++ prefilter does with its
     /// default peak_split_options, packs the split's base with its mips and builds each level's taps
-    /// at the level's roughness from report.json, 32 * 2^(v - 1) samples at virtual level v,
-    /// trilinear reads, the chain's LD weight, its merged peaks and its coarse tail) and renders
+    /// at the level's roughness from report.json, the bake's samples and reads when it was filtered
+    /// by the fast filter, else the fast filter's default plan (64 x 4^(v - 1) samples at virtual
+    /// level v, nearest-level reads), the chain's LD weight, its merged peaks and its coarse tail, or, for a level
+    /// whose kernel needs at most 24 bands, its spherical-harmonic reconstruction) and renders
     /// every face of every level into the chain texture, coarse to fine (a level's coarse tail reads
     /// the next level back from the GPU and packs it). Returns { prepare_ms (split, packing, taps and peaks, CPU),
     /// gpu_ms (the passes, to gl.finish), levels, peaks (level-0 peaks) }.
@@ -439,13 +450,30 @@ class Renderer {
         const weight = spec.ld_weight === 'g1' ? 'g1' : 'nl';
         const plan = [];
         const convolved = (k) => k > 0 && k < chain.levels.length && spec.levels[k] && spec.levels[k].virtual_level > 0;
+        // The rough levels by spherical harmonics (sh_rough_options' defaults): the bands each level
+        // needs, and the split's base projected once onto the most of them.
+        const bands = spec.levels.map((lv, k) => (convolved(k) ? shBands(lv.roughness, weight) : 0));
+        const most = Math.max(0, ...bands), proj = most > 0 ? shProject(packed, most) : null;
         spec.levels.forEach((lv, k) => {
             if (!convolved(k)) return;
-            const samples = Math.min(16384, 32 * 2 ** (lv.virtual_level - 1));
+            const peaks = makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight);
+            if (bands[k] > 0) { // no taps and no coarse tail
+                plan.push({ k, n: chain.levels[k].size, count: 0, taps: new Float32Array(0), info: new Float32Array(0), factor: 0,
+                            tail_share: 0, ...shLevel(proj, lv.roughness, weight, bands[k]), ...peaks });
+                return;
+            }
+            // The bake's own samples and reads when it was filtered by the fast filter, else the fast
+            // filter's defaults (prefilter_plan: fast_default_samples = 64 at level 1, four times as
+            // many per coarser level up to 16384, nearest-level reads).
+            const fast = spec.prefilter === 'fast' && lv.samples > 0;
+            let samples = 64;
+            for (let v = 1; v < lv.virtual_level && samples < 16384; ++v) samples *= 4;
+            if (fast) samples = lv.samples;
+            const trilinear = fast ? lv.trilinear === true : false;
             // The coarse tail (prefilter_options::coarse_tail): from the next level when its face is >= 16.
             const rn = convolved(k + 1) && chain.levels[k + 1].size >= 16 ? spec.levels[k + 1].roughness : -1;
-            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, samples, weight, true, packed, rn),
-                        ...makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight) });
+            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, Math.min(samples, 16384), weight, trilinear, packed, rn),
+                        ...peaks });
         });
         plan.sort((a, b) => b.k - a.k); // coarse to fine: a coarse tail reads the finished next level
         const done = new Map(); // level k -> its faces before their peaks (RGBA floats), for the level before it
@@ -470,6 +498,11 @@ class Renderer {
                 gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, lv.n, lv.n, 0, gl.RGBA, gl.FLOAT, null);
                 gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, beforeTex, 0);
             }
+            // A level that is not read back has no second attachment: one of another level's size
+            // would leave the framebuffer incomplete and the pass would draw nothing.
+            if (f === 0 && !needed(lv)) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, null, 0);
+            const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
+            if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`re-filter: level ${lv.k} face ${f}: framebuffer incomplete (0x${status.toString(16)})`);
             gl.drawBuffers(needed(lv) ? [gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1] : [gl.COLOR_ATTACHMENT0, gl.NONE]);
         }, (lv, f) => {
             if (!needed(lv)) return;
@@ -754,6 +787,29 @@ async function runPrefilterTest() {
                  expected_tail_share: lv.tail_share || 0 };
     });
     const jsPeaks = fx.levels.map((lv) => makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight));
+    // The levels by spherical harmonics: the band choice, the projection of the viewer's packing
+    // onto each weight's most bands, and each level's texture against the C++ one (relative to the
+    // largest coefficient of its row: the projection here is in double, the C++'s float lanes).
+    const jsBands = fx.levels.map((lv) => shBands(lv.roughness, lv.weight));
+    const projections = new Map();
+    for (const w of ['nl', 'g1']) {
+        const most = Math.max(0, ...fx.levels.map((lv, i) => (lv.weight === w ? jsBands[i] : 0)));
+        if (most > 0) projections.set(w, shProject(js, most));
+    }
+    const jsSh = fx.levels.map((lv, i) => shLevel(projections.get(lv.weight), lv.roughness, lv.weight, jsBands[i]));
+    const shDiff = fx.levels.map((lv, i) => {
+        const got = jsSh[i], proj = projections.get(lv.weight);
+        const d = { bands: got.sh_bands, expected_bands: lv.sh_bands, face: proj ? proj.face : 0, expected_face: lv.projection_face };
+        if (got.sh.length !== lv.sh.length) return { ...d, size: got.sh.length, expected_size: lv.sh.length };
+        const pairs = got.sh.length / 12, rel = [0, 0, 0];
+        for (let row = 0; row < 3; ++row) {
+            let big = 0, worst = 0;
+            for (let k = 4 * pairs * row; k < 4 * pairs * (row + 1); ++k) big = Math.max(big, Math.abs(lv.sh[k]));
+            for (let k = 4 * pairs * row; k < 4 * pairs * (row + 1); ++k) worst = Math.max(worst, Math.abs(got.sh[k] - lv.sh[k]));
+            rel[row] = big > 0 ? worst / big : worst;
+        }
+        return { ...d, cosine_max_rel: rel[0], sine_max_rel: rel[1], recurrence_max_rel: rel[2] };
+    });
     const peaksDiff = fx.levels.map((lv, i) => {
         const p = jsPeaks[i];
         if (p.peak_count !== lv.peak_count || p.g1 !== lv.g1) return { count: p.peak_count, expected: lv.peak_count };
@@ -815,10 +871,50 @@ async function runPrefilterTest() {
     const levels = render(fx.levels.map((lv) => ({ ...lv })));
     // The whole live path: the viewer's packing and taps through the same shader.
     packedTexture(gl, js.data, fx.width);
-    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i] })));
+    const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i],
+                                                        ...jsSh[i] })));
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
-                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff,
+                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff, sh: shDiff,
                  source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });
+}
+
+/// The live re-filter test: a bake by the fast filter with a float chain (run_browser_test.py
+/// --mode refilter: ibl-bake --prefilter fast --ktx2-format rgba32f), re-filtered by
+/// Renderer.refilter from its level 0 as the viewer's button does; every re-filtered level is read
+/// back from the chain texture and posted with the level as loaded (what ibl::prefilter wrote).
+async function runRefilterTest() {
+    const bake = await loadBake(urlSource(params.get('bake')));
+    const canvas = document.getElementById('view');
+    const r = new Renderer(canvas, await libraryGlsl(), await fetchText('viewer.frag.glsl'));
+    r.setBake(bake);
+    const gl = r.gl, chain = bake.chain;
+    const loaded = chain.levels.map((lv) => lv.faces.map((a) => Float32Array.from(a)));
+    // The texture's levels >= 1 zeroed first: a level the re-filter did not draw cannot pass.
+    gl.activeTexture(gl.TEXTURE0);
+    gl.bindTexture(gl.TEXTURE_CUBE_MAP, r.chainTex);
+    for (let k = 1; k < chain.levels.length; ++k)
+        for (let f = 0; f < 6; ++f) {
+            const n = chain.levels[k].size;
+            gl.texSubImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, k, 0, 0, n, n, gl.RGBA, gl.FLOAT, new Float32Array(4 * n * n));
+        }
+    const t = r.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
+    const fb = gl.createFramebuffer();
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.readBuffer(gl.COLOR_ATTACHMENT0);
+    const levels = [];
+    for (let k = 1; k < chain.levels.length; ++k) {
+        const n = chain.levels[k].size, cpp = [], gpu = [];
+        for (let f = 0; f < 6; ++f) {
+            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, r.chainTex, k);
+            const px = new Float32Array(4 * n * n);
+            gl.readPixels(0, 0, n, n, gl.RGBA, gl.FLOAT, px);
+            for (let i = 0; i < n * n; ++i)
+                for (let c = 0; c < 3; ++c) gpu.push(px[4 * i + c]), cpp.push(loaded[k][f][4 * i + c]);
+        }
+        levels.push({ level: k, n, cpp, gpu });
+    }
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    await post({ kind: 'refilter', levels, timing: t, renderer: rendererName(gl) });
 }
 
 /// The BC6H decoder test: the fixtures' blocks (tests/browser/bc6h_fixtures.cpp, served as
@@ -965,6 +1061,7 @@ async function main() {
         if (testMode === 'preview') await runPreviewTest();
         else if (testMode === 'numeric') await runNumericTest();
         else if (testMode === 'prefilter') await runPrefilterTest();
+        else if (testMode === 'refilter') await runRefilterTest();
         else if (testMode === 'bc6h') await runBc6hTest();
         else await runViewer();
     } catch (e) {

@@ -415,9 +415,6 @@ namespace detail {
 /// below it the bilinear read of the next level's coarse texels costs more accuracy than the tail
 /// saves (docs/ibl-bake.md, "Fast filter": a 256^2 chain's level 4, reading 8^2, is better without).
 inline constexpr int prefilter_coarse_tail_min_face = 16;
-/// The roughness of the level after plan level k that level k reads its coarse tail from
-/// (prefilter_options::coarse_tail: the fast filter, a convolved level with a next level of face
-/// >= prefilter_coarse_tail_min_face; output level 0 has face first_size), or -1.
 /// The bands of plan level lp when the fast filter reconstructs it from the source's spherical
 /// harmonics (prefilter_options::sh_rough, bake/prefilter_sh.hpp; cubemap sources), else 0.
 template <class Lobe> int prefilter_sh_bands(const prefilter_options& opt, const prefilter_level& lp) {
@@ -425,6 +422,9 @@ template <class Lobe> int prefilter_sh_bands(const prefilter_options& opt, const
     if (lobe_mirror_limit<Lobe>() && lp.level == 0) return 0;
     return sh_rough_bands<Lobe>(std::clamp(std::isfinite(lp.roughness) ? lp.roughness : 0.0, 0.0, 1.0), opt.weight, opt.sh_rough);
 }
+/// The roughness of the level after plan level k that level k reads its coarse tail from
+/// (prefilter_options::coarse_tail: the fast filter, a convolved level with a next level of face
+/// >= prefilter_coarse_tail_min_face; output level 0 has face first_size), or -1.
 /// cube_source: the levels of a cubemap source, where a level by spherical harmonics reads no tail.
 template <class Lobe> double prefilter_tail_roughness(const prefilter_options& opt, const std::vector<prefilter_level>& plan,
                                                       std::size_t k, int first_size, bool cube_source = false) {

@@ -21,6 +21,14 @@
 //         its 1-texel border as detail::pack_cube packs one level; ibl_prefilter_tail adds share
 //         times its bilinear read at the texel centre to the taps, which are then those of the
 //         rest kernel (make_ld_table_for with the next roughness), before the peaks are added.
+//   sh (optional: the fast filter's rough levels by spherical harmonics, bake/prefilter_sh.hpp)
+//         RGBA32F 2-D texture of sh_pair_count(bands) x 3 texels, one column per (l, m) pair in
+//         the C++ kernels' order (m outer, l = m .. bands - 1 inner): row 0 the level's cosine
+//         coefficients (sh_level::coef's R G B, then the norm's: the same level of a constant 1
+//         projected as the source), row 1 the sine ones, row 2 the recurrence's constants (a_lm,
+//         b_lm, sqrt((2m + 1) / (2m)), 0; sh_recurrence). ibl_prefilter_sh reconstructs the level
+//         from them instead of its taps (the level then has no coarse tail); the peaks are added
+//         after it as after the taps.
 // Every operation is the C++ kernel's in the same order (the frame, the branch-free face selection,
 // the bordered bilinear address and weights, the blocks of 32 taps), so the result equals the
 // C++ within float rounding (the browser test: within half-float rounding on every level).
@@ -127,6 +135,39 @@ vec3 ibl_prefilter_peaks(sampler2D peaks, int peak_count, float a2, bool g1, vec
         acc += e.rgb * k;
     }
     return acc;
+}
+
+// A level by spherical harmonics (bake/prefilter_sh.hpp sh_level_lanes16 and sh_level_norm): the
+// normalised associated-Legendre recurrence in dir.z and Re / Im (dir.x + i dir.y)^m, per m the
+// cosine and sine sums over l, then the level's value clamped at 0 over the same reconstruction of
+// a constant 1 (alpha: the norm, which makes a white source exactly white), as the C++ does in float.
+vec3 ibl_prefilter_sh(sampler2D sh, int bands, vec3 dir) {
+    vec4 acc = vec4(0.0);
+    float cr = 1.0, ci = 0.0, qmm = 0.28209479177387814;
+    int p = 0;
+    for (int m = 0; m < bands; ++m) {
+        if (m > 0) {
+            float nr = cr * dir.x - ci * dir.y, ni = cr * dir.y + ci * dir.x;
+            cr = nr;
+            ci = ni;
+            qmm *= texelFetch(sh, ivec2(p, 2), 0).z;
+        }
+        vec4 sc = texelFetch(sh, ivec2(p, 0), 0) * qmm, ss = texelFetch(sh, ivec2(p, 1), 0) * qmm;
+        float q1 = qmm, q2 = 0.0;
+        ++p;
+        for (int l = m + 1; l < bands; ++l, ++p) { // a_(m+1)m = sqrt(2m + 3), b = 0 starts it
+            vec4 ab = texelFetch(sh, ivec2(p, 2), 0);
+            float q = ab.x * (dir.z * q1 - ab.y * q2);
+            q2 = q1;
+            q1 = q;
+            sc += texelFetch(sh, ivec2(p, 0), 0) * q;
+            ss += texelFetch(sh, ivec2(p, 1), 0) * q;
+        }
+        acc += cr * sc + ci * ss;
+    }
+    vec3 v = max(acc.rgb, vec3(0.0));
+    float norm = max(acc.a, 0.0);
+    return norm > 0.0 ? v / norm : v;
 }
 
 // The coarse tail (prefilter_options::coarse_tail, detail::add_coarse_tail_row): share times the
