@@ -260,3 +260,58 @@ TEST_CASE("peak split: the packed patch equals packing the split's base cube, bi
     ibl::detail::packed_cube po = ibl::detail::pack_cube(odd);
     CHECK_FALSE(ibl::detail::patch_packed_peaks(po, odd, so.peaks, so.threshold));
 }
+
+TEST_CASE("peak split: a level keeps at most max_level_peaks merged peaks and their energy; the row cut stays within its bound") {
+    // A grey cube with an extended bright patch (1600 texels at 60 x the grey): about 1024 peaks.
+    constexpr int n = 128;
+    ibl::cubemap<float> src(n);
+    src.fill(0, [&](int f, int x, int y) {
+        const bool patch = f == 2 && x >= 30 && x < 70 && y >= 40 && y < 80;
+        return ibl::vec3<float>(patch ? 60.f + 0.25f * float((x * 7 + y * 3) % 11) : 1.f, patch ? 55.f : 0.9f, 0.8f);
+    });
+    src.generate_mips();
+    const ibl::peak_split_options po;
+    const ibl::cube_peak_split<float> s = ibl::split_cube_peaks(src, po);
+    REQUIRE(s.peaks.size() > 900); // at most max_peaks (ties at the threshold stay in the base)
+    auto energy = [](const ibl::peak_level& pl) {
+        double e = 0.0;
+        for (std::size_t j = 0; j < pl.size(); ++j) e += double(pl.er[j]);
+        return e;
+    };
+    const ibl::peak_level all = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
+                                                     po.max_merge_angle, s.mean_luminance, po.cut, 0);
+    CHECK(all.size() > 128);
+    for (const std::uint32_t cap : {128u, 16u}) {
+        const ibl::peak_level pl = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
+                                                        po.max_merge_angle, s.mean_luminance, po.cut, cap);
+        CHECK(pl.size() <= cap);
+        CHECK(pl.size() > 0);
+        CHECK(energy(pl) == doctest::Approx(energy(all)).epsilon(1e-5));
+    }
+    // The row cut: against every peak added (cut = 0), each texel's luminance is lower by at most
+    // cut times the larger of its row's darkest texel and 1e-2 of the mean luminance.
+    ibl::prefilter_options on = fast_options(16), exact = fast_options(16);
+    exact.peaks.cut = 0.0;
+    const ibl::specular_chain a = ibl::prefilter(src, on, ibl::serial_executor{});
+    const ibl::specular_chain b = ibl::prefilter(src, exact, ibl::serial_executor{});
+    int differ = 0;
+    double worst = 0.0;
+    for (int l = 1; l < a.levels(); ++l) {
+        const int m = a.size(l);
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < m; ++y) {
+                double darkest = 1e300;
+                for (int x = 0; x < m; ++x) darkest = std::min(darkest, double(ibl::luminance(b.texel(f, x, y, l))));
+                const double bound = on.peaks.cut * std::max(darkest, 1e-2 * s.mean_luminance);
+                for (int x = 0; x < m; ++x) {
+                    const double la = ibl::luminance(a.texel(f, x, y, l)), lb = ibl::luminance(b.texel(f, x, y, l));
+                    differ += la != lb ? 1 : 0;
+                    worst = std::max(worst, (lb - la) / bound);
+                    CHECK(lb - la <= bound + 1e-5 * lb);
+                    CHECK(la - lb <= 1e-5 * lb);
+                }
+            }
+    }
+    MESSAGE("row cut: " << differ << " texels differ, the largest by " << worst << " of the bound");
+    CHECK(differ > 0); // the cut skipped something
+}

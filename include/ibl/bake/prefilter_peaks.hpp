@@ -34,9 +34,14 @@
 //     T = max(ratio * mean luminance, luminance of the (max_peaks + 1)-th brightest texel),
 //
 // so a source with nothing above ratio times its mean has no peaks and filters exactly as without
-// the split, and the cost of the exact part is bounded: at most max_peaks kernel evaluations per
-// output texel (fewer after the merge; peaks behind a row's hemisphere are skipped per row).
-// Each evaluation is about ten float operations, vectorised over a face row.
+// the split, and the cost of the exact part is bounded: at most max_level_peaks (128) kernel
+// evaluations per output texel (a level with more merged peaks merges them at coarser mips until
+// it has that many; peaks behind a row's hemisphere, and the faintest within the row cut, are
+// skipped per row). Each evaluation is about ten float operations, vectorised over a face row.
+// Many peaks mean an extended bright region, each of its texels faint next to the whole (the
+// courtyard's 1024 brightest texels carry 0.4 % of its energy); there the coarser merge changes no
+// level's error measurably, while lowering max_peaks would leave a studio's lamps in the tap set
+// (research/peak_budget_study, docs/ibl-bake.md).
 //
 // Determinism: the peak lists depend only on the source and the options; each output texel adds
 // its peaks in list order after the tap sum, the same operations in prefilter and
@@ -82,10 +87,13 @@ struct peak_split_options {
     /// horizon, where n.l cuts them off).
     double footprint = 6.0;
     double max_merge_angle = 1.0 / 16.0;
-    /// Per face row, peaks whose summed largest contributions stay below cut times the row's
-    /// darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
+    /// Per face row, the faintest peaks whose summed largest contributions stay below cut times the
+    /// row's darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
     /// peak that is in front of some texel of the row (the GPU filter's sum).
     double cut = 1e-3;
+    /// At most this many merged peaks per output level (0: no limit): the peaks of a level with
+    /// more are merged at coarser mips until they are this many.
+    std::uint32_t max_level_peaks = 128;
 };
 
 /// One peak: its direction (unit) and its energy (Omega times the radiance above the threshold).
@@ -167,8 +175,13 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
     std::size_t above = 0;
     for (const float l : lum) above += l >= above_t ? 1 : 0;
     if (above > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
-        std::vector<float> sorted(lum);
-        const std::size_t k = count - 1 - std::size_t(opt.max_peaks);
+        // The (max_peaks + 1)-th brightest texel is among the `above` > max_peaks texels above
+        // t: the selection runs over those only (a few thousand, not the whole level).
+        std::vector<float> sorted;
+        sorted.reserve(above);
+        for (const float l : lum)
+            if (l >= above_t) sorted.push_back(l);
+        const std::size_t k = above - 1 - std::size_t(opt.max_peaks);
         std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
         t = std::max(t, double(sorted[k]));
         above_t = least_float_above(t);
@@ -363,7 +376,7 @@ struct peak_level {
 /// GGX lobe at roughness r and the LD weight.
 inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
                                   ld_weight weight, double footprint, double max_angle, double mean_luminance,
-                                  double cut = 1e-3) {
+                                  double cut = 1e-3, std::uint32_t max_level_peaks = 0) {
     peak_level pl;
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
@@ -371,8 +384,10 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
     const double norm = 2.0 * pi_v<double> * detail::ggx_fast_radial_cdf(r, weight)->total;
     if (!(norm > 0.0)) return pl;
     const double scale = a2 / (4.0 * pi_v<double> * norm);
-    const int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
-    for (const cube_peak& p : merge_cube_peaks(peaks, mip)) {
+    int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
+    std::vector<cube_peak> merged = merge_cube_peaks(peaks, mip);
+    while (max_level_peaks > 0 && merged.size() > max_level_peaks && mip < source_levels - 1) merged = merge_cube_peaks(peaks, ++mip);
+    for (const cube_peak& p : merged) {
         pl.px.push_back(p.dir.x), pl.py.push_back(p.dir.y), pl.pz.push_back(p.dir.z);
         pl.er.push_back(float(p.energy.x * scale)), pl.eg.push_back(float(p.energy.y * scale)),
             pl.eb.push_back(float(p.energy.z * scale));
@@ -391,12 +406,17 @@ namespace detail {
 /// Lanes of the peak kernel (a face row in chunks of this many texels, the tail padded).
 inline constexpr int peak_lanes = 16;
 
+/// Buckets of the row cut: peak bounds by their power of two below the row's budget.
+inline constexpr int peak_cut_buckets = 48;
+
 /// Adds the peaks of a level to row y of face `face` of its n x n output: out[x] += sum_j
 /// E_j K(R_x . d_j) / integral K (header comment), the peaks in list order. Per row, a peak is
-/// skipped when it lies beyond the hemisphere of every texel of the row, or when its largest
-/// contribution to the row times the number of peaks is below `cut` (1e-3 by default) of the
-/// row's darkest tap-set result (at least 1e-2 of the source's mean luminance): the skipped peaks
-/// together change no texel of the row by more than `cut` relative.
+/// skipped when it lies beyond the hemisphere of every texel of the row, or when it is among the
+/// faintest peaks whose largest contributions to the row, summed, stay below `cut` (1e-3 by
+/// default) of the row's darkest tap-set result (at least 1e-2 of the source's mean luminance):
+/// the skipped peaks together change no texel of the row by more than `cut` relative. The faintest
+/// are found without sorting: the bounds fall into buckets by their power of two below that
+/// budget, and whole buckets are skipped, faintest first, while their sums stay within it.
 inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<float>* out) {
     if (pl.size() == 0) return;
     // The row's bounding cone: its middle texel's direction and the larger angle to its ends.
@@ -408,9 +428,11 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
     const float ha2 = pl.half_a2, a2 = pl.a2, one_minus_a2 = 1.f - pl.a2;
     float darkest = luminance(out[0]);
     for (int x = 1; x < n; ++x) darkest = std::min(darkest, luminance(out[x]));
-    const float cut = pl.cut * std::max(darkest, pl.floor) / float(pl.size());
+    const float budget = pl.cut * std::max(darkest, pl.floor);
     std::vector<std::uint32_t> live;
+    std::vector<float> bound; // per live peak: its largest contribution to the row (w(c) <= 1 for both weights)
     live.reserve(pl.size());
+    bound.reserve(pl.size());
     for (std::size_t j = 0; j < pl.size(); ++j) {
         // The largest cosine between the peak and a texel of the row: cos(max(0, a - half)), a
         // the angle to the middle texel (1 inside the cone); behind the row when it is <= 0.
@@ -418,8 +440,32 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
         const float c_max = ca >= cos_half ? 1.f : ca * cos_half + std::sqrt(std::max(0.f, 1.f - ca * ca)) * sin_half;
         if (!(c_max > 0.f)) continue;
         const float qb = 0.5f * (1.f - c_max) + ha2 * (1.f + c_max);
-        if (cut > 0.f && pl.lum[j] / (qb * qb) < cut) continue; // w(c) <= 1 for both weights
         live.push_back(std::uint32_t(j));
+        bound.push_back(pl.lum[j] / (qb * qb));
+    }
+    if (budget > 0.f && !live.empty()) {
+        // Bucket b holds the bounds in [budget 2^-(b+1), budget 2^-b) (the last one everything
+        // fainter; bounds >= budget are never skipped): skip buckets from the faintest while
+        // their running sum stays within the budget.
+        double sum[peak_cut_buckets] = {};
+        auto bucket_of = [&](float v) {
+            if (!(v < budget)) return -1;
+            if (!(v > 0.f)) return peak_cut_buckets - 1;
+            int e = 0;
+            std::frexp(v / budget, &e); // v / budget in [2^(e-1), 2^e), e <= 0
+            return std::min(-e, peak_cut_buckets - 1);
+        };
+        for (const float v : bound)
+            if (const int b = bucket_of(v); b >= 0) sum[b] += double(v);
+        double skipped = 0.0;
+        int first_kept = peak_cut_buckets; // buckets >= first_kept are skipped
+        for (int b = peak_cut_buckets - 1; b >= 0 && skipped + sum[b] <= double(budget); --b) skipped += sum[b], first_kept = b;
+        std::size_t k = 0;
+        for (std::size_t i = 0; i < live.size(); ++i) {
+            const int b = bucket_of(bound[i]);
+            if (b < 0 || b < first_kept) live[k++] = live[i];
+        }
+        live.resize(k);
     }
     if (live.empty()) return;
     constexpr int W = peak_lanes;

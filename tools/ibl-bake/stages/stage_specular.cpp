@@ -97,7 +97,7 @@ public:
             ibl::peak_split_options po;
             po.max_peaks = ctx.opt.fast_peaks;
             const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(ctx.source, po, ctx.ex);
-            peaks_ = {true, po.ratio, po.max_peaks, split.peaks.size(), split.threshold, split.mean_luminance};
+            peaks_ = {true, po.ratio, po.max_peaks, po.max_level_peaks, split.peaks.size(), split.threshold, split.mean_luminance};
         }
         chain_ = &*ctx.chain;
         sp_ = ctx.plan.specular;
@@ -163,7 +163,7 @@ private:
     struct peak_report {
         bool on = false;
         double ratio = 0.0;
-        std::uint32_t max_peaks = 0;
+        std::uint32_t max_peaks = 0, max_level_peaks = 0;
         std::size_t count = 0;
         double threshold = 0.0, mean = 0.0;
     } peaks_;
@@ -313,7 +313,8 @@ void specular_stage::report(json_writer& j) const {
         j.end_array().end_object();
         j.key("peaks").begin_object().key("enabled").value(peaks_.on);
         if (peaks_.on)
-            j.key("ratio").value(peaks_.ratio).key("max_peaks").value(peaks_.max_peaks).key("count").value(std::uint64_t(peaks_.count))
+            j.key("ratio").value(peaks_.ratio).key("max_peaks").value(peaks_.max_peaks).key("max_level_peaks").value(peaks_.max_level_peaks)
+                .key("count").value(std::uint64_t(peaks_.count))
                 .key("threshold").value(peaks_.threshold).key("mean_luminance").value(peaks_.mean);
         j.end_object();
     }
