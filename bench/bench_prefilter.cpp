@@ -249,6 +249,53 @@ void BM_prefilter_update_step(benchmark::State& state) {
     }
 }
 
+/// A dynamic probe's slice by time: one prefilter_update::step_for of range(1) microseconds (the
+/// time form of BM_prefilter_update_step: about 2^14, 2^16, 2^18 and 2^20 taps on one thread) on
+/// the 256^2 source, FIS (range(2) = 0) or the fast filter (1), one thread, the pass restarted when
+/// it finishes (set_source outside the timed call). Counters: the 99th percentile, the slowest and
+/// the mean of the calls' times over the budget, taps per call, and the largest difference of the
+/// finished chain from the one-shot prefilter (0: bit for bit).
+void BM_prefilter_update_time(benchmark::State& state) {
+    const ibl::cubemap<float>& src = source(int(state.range(0)));
+    const std::chrono::microseconds budget(state.range(1));
+    ibl::prefilter_options o;
+    if (state.range(2) == 1) o.method = ibl::prefilter_method::fast;
+    ibl::prefilter_update<> up(src, o);
+    std::uint64_t taps = 0, calls = 0;
+    std::vector<double> times;
+    for (auto _ : state) {
+        if (up.done()) {
+            state.PauseTiming();
+            up.set_source(src);
+            state.ResumeTiming();
+        }
+        const auto t0 = std::chrono::steady_clock::now();
+        taps += up.step_for(budget);
+        times.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        ++calls;
+    }
+    up.finish();
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::thread_executor{2});
+    double diff = 0.0;
+    for (int l = 0; l < ref.levels(); ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < ref.size(l); ++y)
+                for (int x = 0; x < ref.size(l); ++x)
+                    for (int c = 0; c < 3; ++c)
+                        diff = std::max(diff, double(std::abs(up.result()->texel(f, x, y, l)[c] - ref.texel(f, x, y, l)[c])));
+    const double b = std::chrono::duration<double>(budget).count();
+    double mean = 0.0;
+    for (const double t : times) mean += t / double(times.size());
+    state.counters["taps_per_call"] = double(taps) / double(std::max<std::uint64_t>(calls, 1));
+    state.counters["max_abs_vs_oneshot"] = diff;
+    state.counters["mean_call_over_budget"] = mean / b;
+    state.counters["slowest_call_over_budget"] = *std::max_element(times.begin(), times.end()) / b;
+    const auto p99 = times.begin() + std::ptrdiff_t((times.size() - 1) * 99 / 100);
+    std::nth_element(times.begin(), p99, times.end());
+    state.counters["p99_call_over_budget"] = *p99 / b;
+    state.counters["ns_per_tap"] = up.seconds_per_tap() * 1e9;
+}
+
 /// The batch kernel against its width-1 form: one level of the default chain (level 2 of the
 /// 256^2 sky with a sun: 64^2 faces, 1024 samples, trilinear reads), every face row computed by
 /// convolve_lanes<W> in chunks of W lanes (W = range(0): 16 is the library's convolve_width, 1 the
@@ -434,6 +481,7 @@ BENCHMARK(BM_convolve_xsimd)
     ->UseRealTime();
 #endif
 BENCHMARK(BM_prefilter_update_step)->ArgNames({"env", "log2_budget", "fast"})->ArgsProduct({{1}, {14, 16, 18, 20}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_prefilter_update_time)->ArgNames({"env", "us", "fast"})->ArgsProduct({{1}, {50, 200, 800, 3200}, {0, 1}})->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_fixed_call_spread)->ArgName("log2_taps")->DenseRange(14, 20, 2)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_default)->ArgName("env")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_prefilter_fis)

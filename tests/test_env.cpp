@@ -687,3 +687,20 @@ TEST_CASE("sky baked to a cubemap keeps its total power") {
             " vs ", want.x);
     CHECK(all.x == doctest::Approx(want.x).epsilon(0.05));
 }
+
+TEST_CASE("cubemap: an edge's border sources are affine along it, the texels border_source folds to") {
+    for (int n = 1; n <= 64; ++n)
+        for (int f = 0; f < 6; ++f)
+            for (int e = 0; e < 4; ++e) {
+                const ibl::cubemap<float>::border_edge b = ibl::cubemap<float>::border_edge_source(f, e, n);
+                for (int i = 0; i < n; ++i) {
+                    const int x = e == 0 ? -1 : e == 1 ? n : i, y = e == 2 ? -1 : e == 3 ? n : i;
+                    int g = -1, gx = -1, gy = -1;
+                    ibl::cubemap<float>::border_source(f, x, y, n, g, gx, gy);
+                    REQUIRE(g == b.g);
+                    REQUIRE(gx == b.x0 + b.dx * i);
+                    REQUIRE(gy == b.y0 + b.dy * i);
+                    REQUIRE(g != f);
+                }
+            }
+}

@@ -10,6 +10,7 @@
 #include <ibl/env/cubemap.hpp>
 
 #include <algorithm>
+#include <chrono>
 #include <cstdint>
 #include <cstring>
 #include <stdexcept>
@@ -79,11 +80,12 @@ TEST_CASE("prefilter_update: rows dearer than the budget are computed in pieces,
     const ibl::cubemap<float> src = sky(64, 200.0f);
     ibl::prefilter_options o;
     o.method = ibl::prefilter_method::fast;
-    o.samples_per_level = {0, 16, 64, 256, 1024};
+    o.samples_per_level = {0, 16, 64, 256, 8192};
     o.levels = 5;
     o.sh_rough.enabled = false; // tap sets on every level (the rough levels by SH: tests/test_prefilter_sh.cpp)
     const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::serial_executor{});
-    for (std::uint64_t budget : {std::uint64_t(3000), std::uint64_t(4000)}) {
+    // above the dearest unit (the split's patch of about 200 peaks), below the coarsest level's rows
+    for (std::uint64_t budget : {std::uint64_t(12000), std::uint64_t(16000)}) {
         ibl::prefilter_update<> up(src, o);
         std::uint64_t unit = up.setup_unit_taps(), dearest_row = 0;
         for (std::size_t k = 0; k < up.plan().size(); ++k) {
@@ -188,4 +190,29 @@ TEST_CASE("prefilter_update: budget 0 does nothing; bad options throw as prefilt
     bad = small_options();
     bad.levels = -3;
     CHECK_THROWS_AS(ibl::prefilter_update<>(src, bad), std::invalid_argument);
+}
+
+TEST_CASE("prefilter_update: a time budget finishes with the one-shot chain, bit for bit, and makes progress") {
+    // Only the bits and the progress are checked here (timing is the benchmark's:
+    // bench/bench_prefilter.cpp, BM_prefilter_update_time).
+    const ibl::cubemap<float> src = sky(32, 200.0f);
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::serial_executor{});
+    for (const auto budget : {std::chrono::microseconds(1), std::chrono::microseconds(30), std::chrono::microseconds(2000)}) {
+        ibl::prefilter_update<> up(src, o);
+        CHECK(up.step_for(std::chrono::microseconds(0)) == 0); // nothing for no time
+        std::uint64_t spent = 0;
+        int calls = 0;
+        while (!up.done()) {
+            const std::uint64_t s = up.step_for(budget, ibl::thread_executor{2});
+            CHECK(s > 0); // at least one unit a call
+            spent += s;
+            ++calls;
+            REQUIRE(calls < 200000);
+        }
+        CHECK(spent == up.total_taps());
+        CHECK(up.seconds_per_tap() > 0.0);
+        CHECK(same_bits(*up.result(), ref));
+    }
 }

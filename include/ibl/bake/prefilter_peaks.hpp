@@ -261,6 +261,10 @@ namespace detail {
 inline bool patch_packed_peaks(packed_cube& p, const cubemap<float>& src, const std::vector<cube_peak>& peaks, double t) {
     if (!peak_mips_nest(src) || int(p.levels.size()) != src.levels()) return false;
     std::vector<std::uint8_t> mark;
+    // The solid angles of the patched texels of the current coarse row, each computed once: the
+    // peaks come in face, row, column order, so those of one coarse row are consecutive.
+    std::vector<double> row_omega;
+    std::vector<int> touched;
     for (int l = 0; l < src.levels(); ++l) {
         const packed_cube::level& li = p.levels[std::size_t(l)];
         const int n = li.n;
@@ -268,26 +272,42 @@ inline bool patch_packed_peaks(packed_cube& p, const cubemap<float>& src, const 
             return p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
                                         std::size_t(y + 1) * std::size_t(li.stride) + std::size_t(x + 1));
         };
-        mark.assign(std::size_t(6) * std::size_t(n) * std::size_t(n), 0);
+        row_omega.assign(std::size_t(n), 0.0);
+        touched.clear();
+        int row_face = -1, row_y = -1;
+        bool on_edge = false; // a patched texel on a face's edge: some border (or corner) copies it
         for (const cube_peak& pk : peaks) {
             const int x = pk.x >> l, y = pk.y >> l;
             float* q = at(pk.face, x, y);
             const vec3<float> v(q[0], q[1], q[2]);
             vec3<float> w;
-            if (l == 0) w = vec3<float>(vec3<double>(v) * (t / double(pk.luminance)));
-            else w = vec3<float>(max(vec3<double>(v) - pk.energy / cube_texel_solid_angle<double>(x, y, n), vec3<double>(0.0)));
+            if (l == 0) {
+                w = vec3<float>(vec3<double>(v) * (t / double(pk.luminance)));
+            } else {
+                if (pk.face != row_face || y != row_y) {
+                    for (const int i : touched) row_omega[std::size_t(i)] = 0.0;
+                    touched.clear();
+                    row_face = pk.face, row_y = y;
+                }
+                double& om = row_omega[std::size_t(x)];
+                if (om == 0.0) om = cube_texel_solid_angle<double>(x, y, n), touched.push_back(x);
+                w = vec3<float>(max(vec3<double>(v) - pk.energy / om, vec3<double>(0.0)));
+            }
             for (int k = 0; k < 3; ++k) q[k] = is_finite(w[k]) ? w[k] : 0.f;
-            mark[cube_texel_index(pk.face, x, y, n)] = 1;
+            on_edge = on_edge || x == 0 || y == 0 || x == n - 1 || y == n - 1;
         }
+        if (!on_edge) continue; // no border texel copies a patched one, no corner averages one
+        mark.assign(std::size_t(6) * std::size_t(n) * std::size_t(n), 0);
+        for (const cube_peak& pk : peaks) mark[cube_texel_index(pk.face, pk.x >> l, pk.y >> l, n)] = 1;
         for (int f = 0; f < 6; ++f) {
-            for (int i = 0; i < n; ++i) {
-                const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
-                for (int e = 0; e < 4; ++e) {
-                    int g, gx, gy;
-                    cubemap<float>::border_source(f, xs[e], ys[e], n, g, gx, gy);
-                    if (!mark[cube_texel_index(g, gx, gy, n)]) continue;
-                    const float* from = at(g, gx, gy);
-                    float* to = at(f, xs[e], ys[e]);
+            for (int e = 0; e < 4; ++e) {
+                const cubemap<float>::border_edge b = cubemap<float>::border_edge_source(f, e, n);
+                for (int i = 0; i < n; ++i) {
+                    const int gx = b.x0 + b.dx * i, gy = b.y0 + b.dy * i;
+                    if (!mark[cube_texel_index(b.g, gx, gy, n)]) continue;
+                    const int x = e == 0 ? -1 : e == 1 ? n : i, y = e == 2 ? -1 : e == 3 ? n : i;
+                    const float* from = at(b.g, gx, gy);
+                    float* to = at(f, x, y);
                     for (int k = 0; k < 3; ++k) to[k] = from[k];
                 }
             }

@@ -49,12 +49,20 @@
 //
 // A pass starts with more units: the packed copy of the source that the taps read, a bordered row
 // of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
-// filter's peak split, the patch that takes the peaks out of it (1 + P L taps, P peaks, L levels),
+// filter's peak split, the patch that takes the peaks out of it (1 + 8 P L taps, P peaks, L levels),
 // then, when the fast filter reconstructs rough levels from spherical harmonics
 // (bake/prefilter_sh.hpp), the projection of the packed source, a row of its level per unit
 // (1 + ceil(m B^2 / 12) taps for m texels and B bands), then the reduction of its sums (one unit). A
 // level by spherical harmonics is computed in whole rows of 16-lane chunks, 16 ceil(n_l / 16) ceil(B_l^2 / 24) taps plus the
 // row's peaks (as its finish), like a mirror level's rows.
+//
+// Time budgets. step_for(duration) runs step in slices, each given half of the time left at the
+// rate measured by the earlier slices and calls (seconds a tap, seconds_per_tap()), reading the
+// clock between slices only. A slice whose true rate is within 2x of the estimate ends within the
+// time left, so the call ends within its budget unless one unit alone is dearer than what is left;
+// the rate differs by phase (a row's taps run on one thread, whole rows through the executor; a
+// row's cost depends on where its taps read) by up to 1.7x on one thread, which the halving absorbs
+// where a fixed tap budget cannot (bench/bench_prefilter.cpp, BM_prefilter_update_time).
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
 // copy of every texel, none when the source is moved in), runs the fast filter's peak split (a pass
@@ -69,6 +77,8 @@
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
+#include <algorithm>
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -118,101 +128,46 @@ public:
     /// calling thread. Returns the taps computed; finishing a pass publishes it as result().
     template <class Executor = serial_executor>
     std::uint64_t step(std::uint64_t budget, Executor&& ex = Executor{}) {
+        return step_units(budget, ex, true);
+    }
+
+    /// Computes work units for about `budget` of wall time instead of a number of taps (header
+    /// comment, "Time budgets"): slices of step(taps), each given half of the time left at the
+    /// rate measured so far (kept across calls), until the time left holds less than a lane tap
+    /// (16 taps) at that rate or the next unit does not fit the slice. At least one unit when
+    /// budget > 0 and the pass is not finished (as step). Returns the taps computed; the finished
+    /// chain is the same as with step (the same units in the same order).
+    template <class Rep, class Period, class Executor = serial_executor>
+    std::uint64_t step_for(std::chrono::duration<Rep, Period> budget, Executor&& ex = Executor{}) {
+        using clock = std::chrono::steady_clock;
+        const double total = std::chrono::duration<double>(budget).count();
+        if (!(total > 0.0)) return 0;
+        const clock::time_point start = clock::now();
+        double elapsed = 0.0;
         std::uint64_t spent = 0;
-        bool stop = false;
-        while (!pass_done_ && !stop && spent < budget) {
-            if (!packed_) { // the pass's first units: the packed copy of the source, then the split's patch
-                if (pack_item_ < src_->pack_items()) {
-                    const std::uint64_t c = pack_item_taps(pack_item_);
-                    if (spent > 0 && c > budget - spent) break;
-                    src_->pack(*source_, pack_item_, pack_item_ + 1);
-                    ++pack_item_;
-                    spent += c;
-                    continue;
-                }
-                if (spent > 0 && patch_taps() > budget - spent) break;
-                serial_executor one;
-                src_->finish_packing(*source_, one);
-                packed_ = true;
-                spent += patch_taps();
-                continue;
+        while (!pass_done_) {
+            const double fit = 0.5 * (total - elapsed) / seconds_per_tap_;
+            std::uint64_t k = fit < 1e15 ? std::uint64_t(std::max(0.0, fit)) : std::uint64_t(1e15);
+            if (k < detail::convolve_width) {
+                if (spent > 0) break;
+                k = 1; // progress: one unit even above the budget
             }
-            if (sh_row_ < src_->sh_rows()) { // the projection of the levels by spherical harmonics, a row per unit
-                if (spent > 0 && sh_row_taps() > budget - spent) break;
-                src_->sh_add_row(sh_row_++);
-                spent += sh_row_taps();
-                continue;
+            const clock::time_point t0 = clock::now();
+            const std::uint64_t t = step_units(k, ex, spent == 0); // the first slice makes progress
+            const clock::time_point t1 = clock::now();
+            elapsed = std::chrono::duration<double>(t1 - start).count();
+            if (t > 0) { // the rate: slices of 2^16 taps and more replace it, smaller ones move it by their share
+                const double rate = std::chrono::duration<double>(t1 - t0).count() / double(t);
+                const double a = std::min(1.0, double(t) / 65536.0);
+                if (rate > 0.0) seconds_per_tap_ = (1.0 - a) * seconds_per_tap_ + a * rate;
             }
-            if (!sh_done_) { // then the reduction of its sums and the levels' coefficients, one unit
-                if (src_->sh_rows() > 0) {
-                    if (spent > 0 && sh_finish_taps() > budget - spent) break;
-                    src_->sh_finish();
-                    for (level_work& w : levels_) src_->sh_fill(w.conv);
-                    spent += sh_finish_taps();
-                }
-                sh_done_ = true;
-                continue;
-            }
-            const level_work& lw = levels_[level_];
-            const std::size_t rows_total = std::size_t(6 * lw.n);
-            if (row_ == rows_total) { // the finished level's borders, a face per unit
-                if (spent > 0 && lw.border_taps > budget - spent) break;
-                back_->update_borders(int(level_), int(face_));
-                if (levels_[level_].as_next) levels_[level_].as_next->update_borders(0, int(face_));
-                spent += lw.border_taps;
-                if (++face_ == 6) next_level();
-                continue;
-            }
-            if (chunk_ == 0 && tap_ == 0) { // at the start of a row: whole rows, in parallel
-                std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
-                if (lw.whole_rows() && rows == 0 && spent == 0) rows = 1; // progress: one unit even above the budget
-                if (rows > 0) {
-                    run_rows(row_, row_ + rows, ex);
-                    spent += rows * lw.taps_per_row;
-                    row_ += rows;
-                    continue;
-                }
-                if (lw.whole_rows()) break;
-            }
-            // A row that does not fit: its chunks of lanes, and the taps of a chunk, while they fit.
-            const std::uint64_t count = lw.conv.taps.w.size();
-            while (true) {
-                const auto [x0, w] = lw.chunks[chunk_];
-                const bool last = chunk_ + 1 == lw.chunks.size();
-                const std::uint64_t lanes = std::uint64_t(w), fin = last ? lw.finish_taps : 0;
-                const std::uint64_t left = count - tap_, room = budget - spent;
-                std::uint64_t k = left;
-                bool complete = true;
-                if (left * lanes + fin > room) { // the taps that fit, short of the one that carries the finish
-                    k = std::min<std::uint64_t>(room / lanes, last && left > 0 ? left - 1 : left);
-                    complete = false;
-                    if (k == 0) {
-                        if (spent > 0) {
-                            stop = true;
-                            break;
-                        }
-                        complete = left <= 1; // progress: one unit even above the budget
-                        k = complete ? left : 1;
-                    }
-                }
-                run_chunk_taps(x0, w, tap_ + std::size_t(k));
-                spent += k * lanes + (complete ? fin : 0);
-                tap_ += std::size_t(k);
-                if (!complete) {
-                    stop = true;
-                    break;
-                }
-                finish_chunk(x0, w);
-                tap_ = 0;
-                if (++chunk_ < lw.chunks.size()) continue;
-                chunk_ = 0;
-                finish_row();
-                ++row_;
-                break;
-            }
+            spent += t;
+            if (t == 0) break; // the next unit is dearer than the slice
         }
         return spent;
     }
+    /// The rate step_for plans with (seconds a tap, as measured by its calls so far).
+    double seconds_per_tap() const noexcept { return seconds_per_tap_; }
 
     /// Runs the rest of the pass (no budget).
     template <class Executor = serial_executor> void finish(Executor&& ex = Executor{}) {
@@ -265,6 +220,105 @@ public:
     }
 
 private:
+    /// step's loop; progress: at least one unit even when it exceeds the budget (step), else none
+    /// that does (step_for's slices after the first).
+    template <class Executor> std::uint64_t step_units(std::uint64_t budget, Executor& ex, bool progress) {
+        std::uint64_t spent = 0;
+        bool stop = false;
+        while (!pass_done_ && !stop && spent < budget) {
+            if (!packed_) { // the pass's first units: the packed copy of the source, then the split's patch
+                if (pack_item_ < src_->pack_items()) {
+                    const std::uint64_t c = pack_item_taps(pack_item_);
+                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    src_->pack(*source_, pack_item_, pack_item_ + 1);
+                    ++pack_item_;
+                    spent += c;
+                    continue;
+                }
+                if ((spent > 0 || !progress) && patch_taps() > budget - spent) break;
+                serial_executor one;
+                src_->finish_packing(*source_, one);
+                packed_ = true;
+                spent += patch_taps();
+                continue;
+            }
+            if (sh_row_ < src_->sh_rows()) { // the projection of the levels by spherical harmonics, a row per unit
+                if ((spent > 0 || !progress) && sh_row_taps() > budget - spent) break;
+                src_->sh_add_row(sh_row_++);
+                spent += sh_row_taps();
+                continue;
+            }
+            if (!sh_done_) { // then the reduction of its sums and the levels' coefficients, one unit
+                if (src_->sh_rows() > 0) {
+                    if ((spent > 0 || !progress) && sh_finish_taps() > budget - spent) break;
+                    src_->sh_finish();
+                    for (level_work& w : levels_) src_->sh_fill(w.conv);
+                    spent += sh_finish_taps();
+                }
+                sh_done_ = true;
+                continue;
+            }
+            const level_work& lw = levels_[level_];
+            const std::size_t rows_total = std::size_t(6 * lw.n);
+            if (row_ == rows_total) { // the finished level's borders, a face per unit
+                if ((spent > 0 || !progress) && lw.border_taps > budget - spent) break;
+                back_->update_borders(int(level_), int(face_));
+                if (levels_[level_].as_next) levels_[level_].as_next->update_borders(0, int(face_));
+                spent += lw.border_taps;
+                if (++face_ == 6) next_level();
+                continue;
+            }
+            if (chunk_ == 0 && tap_ == 0) { // at the start of a row: whole rows, in parallel
+                std::size_t rows = std::size_t(std::min<std::uint64_t>(rows_total - row_, (budget - spent) / lw.taps_per_row));
+                if (lw.whole_rows() && rows == 0 && spent == 0 && progress) rows = 1; // progress: one unit even above the budget
+                if (rows > 0) {
+                    run_rows(row_, row_ + rows, ex);
+                    spent += rows * lw.taps_per_row;
+                    row_ += rows;
+                    continue;
+                }
+                if (lw.whole_rows()) break;
+            }
+            // A row that does not fit: its chunks of lanes, and the taps of a chunk, while they fit.
+            const std::uint64_t count = lw.conv.taps.w.size();
+            while (true) {
+                const auto [x0, w] = lw.chunks[chunk_];
+                const bool last = chunk_ + 1 == lw.chunks.size();
+                const std::uint64_t lanes = std::uint64_t(w), fin = last ? lw.finish_taps : 0;
+                const std::uint64_t left = count - tap_, room = budget - spent;
+                std::uint64_t k = left;
+                bool complete = true;
+                if (left * lanes + fin > room) { // the taps that fit, short of the one that carries the finish
+                    k = std::min<std::uint64_t>(room / lanes, last && left > 0 ? left - 1 : left);
+                    complete = false;
+                    if (k == 0) {
+                        if (spent > 0 || !progress) {
+                            stop = true;
+                            break;
+                        }
+                        complete = left <= 1; // progress: one unit even above the budget
+                        k = complete ? left : 1;
+                    }
+                }
+                run_chunk_taps(x0, w, tap_ + std::size_t(k));
+                spent += k * lanes + (complete ? fin : 0);
+                tap_ += std::size_t(k);
+                if (!complete) {
+                    stop = true;
+                    break;
+                }
+                finish_chunk(x0, w);
+                tap_ = 0;
+                if (++chunk_ < lw.chunks.size()) continue;
+                chunk_ = 0;
+                finish_row();
+                ++row_;
+                break;
+            }
+        }
+        return spent;
+    }
+
     /// The new pass on source_ (set_source).
     void restart(bool same_shape) {
         serial_executor ex;
@@ -323,7 +377,7 @@ private:
         return t;
     }
     /// The split's patch: a few texels per peak and level of the packed copy.
-    std::uint64_t patch_taps() const noexcept { return 1 + std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
+    std::uint64_t patch_taps() const noexcept { return 1 + 8 * std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
     /// Coefficients of the spherical-harmonic projection (one source texel, one (l, m): a basis
     /// value and three multiply-adds) and of a level's reconstruction (one output texel, one (l, m))
     /// counted as one tap (measured by bench/bench_prefilter.cpp, BM_prefilter_update_step).
@@ -530,6 +584,9 @@ private:
     std::vector<vec3<float>*> outs_;    ///< the rows of a call's whole rows in the chain under construction
     std::vector<vec3<float>*> befores_; ///< and in as_next (or null)
     bool pass_done_ = false;
+    /// step_for's rate: starts slow (10 ns a tap, about three times this VM's one-thread rate) so
+    /// that a first call ends early rather than late, then follows the measured one.
+    double seconds_per_tap_ = 1e-8;
     std::optional<specular_chain> result_;
     std::optional<cubemap<float>> back_; ///< the chain under construction (rows written in place)
 };

@@ -251,6 +251,28 @@ public:
         fold_border(face, x, y, n, g, gx, gy);
     }
 
+    /// The sources of one edge of border texels at once: edge e of `face` (0: x = -1, 1: x = n,
+    /// 2: y = -1, 3: y = n; i along it from 0 to n - 1) copies texel (x0 + dx i, y0 + dy i) of face
+    /// g, the same texels as border_source (the fold is affine along an edge; tests/test_cubemap.cpp
+    /// checks every texel of every edge up to n = 64).
+    struct border_edge {
+        int g = 0, x0 = 0, y0 = 0, dx = 0, dy = 0;
+    };
+    static border_edge border_edge_source(int face, int e, int n) noexcept {
+        auto at = [&](int i, int& g, int& gx, int& gy) {
+            const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
+            fold_border(face, xs[e], ys[e], n, g, gx, gy);
+        };
+        border_edge b;
+        at(0, b.g, b.x0, b.y0);
+        if (n > 1) {
+            int g, x1, y1;
+            at(n - 1, g, x1, y1);
+            b.dx = (x1 - b.x0) / (n - 1), b.dy = (y1 - b.y0) / (n - 1);
+        }
+        return b;
+    }
+
     /// Rebuilds the 1-texel borders of every face of every level from the interiors.
     void update_borders() {
         for (int l = 0; l < levels(); ++l) {
@@ -369,12 +391,11 @@ private:
     /// The borders of one face of a level: its edges from the neighbours' interiors, then its corners.
     void build_face_borders(int level, int f) {
         const int n = size(level);
-        for (int i = 0; i < n; ++i) {
-            const int xs[4] = {-1, n, i, i}, ys[4] = {i, i, -1, n};
-            for (int e = 0; e < 4; ++e) {
-                int g, gx, gy;
-                fold_border(f, xs[e], ys[e], n, g, gx, gy);
-                data_[index(f, xs[e], ys[e], level)] = data_[index(g, gx, gy, level)];
+        for (int e = 0; e < 4; ++e) {
+            const border_edge b = border_edge_source(f, e, n);
+            for (int i = 0; i < n; ++i) {
+                const int x = e == 0 ? -1 : e == 1 ? n : i, y = e == 2 ? -1 : e == 3 ? n : i;
+                data_[index(f, x, y, level)] = data_[index(b.g, b.x0 + b.dx * i, b.y0 + b.dy * i, level)];
             }
         }
         const int cx[2] = {-1, n}, ix[2] = {0, n - 1};
