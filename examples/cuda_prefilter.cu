@@ -3,7 +3,8 @@
 // ibl::prefilter builds) and packs the source (ibl::detail::pack_cube); the device runs the C++
 // kernel's per-texel arithmetic with the IBL_FUNC functions (cube_texel_direction, make_frame,
 // detail::lane_cube_coord), one thread per output texel, one launch per level. The result is
-// compared with ibl::prefilter on the host and the device time is printed.
+// compared with ibl::prefilter on the host (with the same options: the tap sets alone, without the
+// default's peak split, coarse tail and levels by spherical harmonics) and the device time is printed.
 //
 //   nvcc -std=c++20 --expt-relaxed-constexpr -I include -I /usr/include examples/cuda_prefilter.cu -o cuda_prefilter
 //   ./cuda_prefilter [face size, default 256]
@@ -81,7 +82,12 @@ int main(int argc, char** argv) {
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2, ibl::thread_executor{});
     ibl::prefilter_options o;
     o.method = ibl::prefilter_method::fast;
-    o.sh_rough.enabled = false; // the kernel below runs the tap sets on every level (the rough levels by SH are CPU only)
+    // The kernel below is the tap set alone, on every level: the C++ chain it is compared with is
+    // filtered the same way (the default chain adds the peak split, the coarse tail and the rough
+    // levels by spherical harmonics, which include/ibl/glsl/ibl_prefilter.glsl runs on a GPU).
+    o.sh_rough.enabled = false;
+    o.peaks.enabled = false;
+    o.coarse_tail = false;
     const ibl::specular_chain chain = ibl::prefilter(src, o, ibl::thread_executor{});
     const ibl::detail::packed_cube packed = ibl::detail::pack_cube(src);
     float4* d_src = nullptr;
