@@ -261,7 +261,7 @@ TEST_CASE("peak split: the packed patch equals packing the split's base cube, bi
     CHECK_FALSE(ibl::detail::patch_packed_peaks(po, odd, so.peaks, so.threshold));
 }
 
-TEST_CASE("peak split: a level keeps at most max_level_peaks merged peaks and their energy; the row cut stays within its bound") {
+TEST_CASE("peak split: a level above max_level_peaks merges one mip coarser, keeping the energy; the row cut stays within its bound") {
     // A grey cube with an extended bright patch (1600 texels at 60 x the grey): about 1024 peaks.
     constexpr int n = 128;
     ibl::cubemap<float> src(n);
@@ -280,14 +280,27 @@ TEST_CASE("peak split: a level keeps at most max_level_peaks merged peaks and th
     };
     const ibl::peak_level all = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
                                                      po.max_merge_angle, s.mean_luminance, po.cut, 0);
+    const int mip = ibl::peak_merge_mip(0.2, n, src.levels() - 1, po.footprint, po.max_merge_angle);
+    CHECK(all.size() == ibl::merge_cube_peaks(s.peaks, mip).size());
     CHECK(all.size() > 128);
+    // above the cap: merged one mip coarser (and no further)
+    const std::size_t coarser = ibl::merge_cube_peaks(s.peaks, mip + 1).size();
     for (const std::uint32_t cap : {128u, 16u}) {
         const ibl::peak_level pl = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
                                                         po.max_merge_angle, s.mean_luminance, po.cut, cap);
-        CHECK(pl.size() <= cap);
-        CHECK(pl.size() > 0);
+        CHECK(pl.size() == coarser);
+        CHECK(pl.size() < all.size());
         CHECK(energy(pl) == doctest::Approx(energy(all)).epsilon(1e-5));
     }
+    const ibl::peak_level roomy = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
+                                                       po.max_merge_angle, s.mean_luminance, po.cut, std::uint32_t(all.size()));
+    CHECK(roomy.size() == all.size()); // at the cap: the footprint rule's merge
+    // A rough level merges at max_merge_angle already: never coarser, whatever the cap.
+    const int rough_mip = ibl::peak_merge_mip(1.0, n, src.levels() - 1, po.footprint, po.max_merge_angle);
+    const ibl::peak_level rough = ibl::make_peak_level(s.peaks, n, src.levels(), 1.0, ibl::ld_weight::n_dot_l, po.footprint,
+                                                       po.max_merge_angle, s.mean_luminance, po.cut, 1);
+    CHECK(rough.size() == ibl::merge_cube_peaks(s.peaks, rough_mip).size());
+    CHECK(2.0 / double(n >> (rough_mip + 1)) > po.max_merge_angle);
     // The row cut: against every peak added (cut = 0), each texel's luminance is lower by at most
     // cut times the larger of its row's darkest texel and 1e-2 of the mean luminance.
     ibl::prefilter_options on = fast_options(16), exact = fast_options(16);

@@ -366,7 +366,7 @@ function peakMergeMip(r, n0, maxMip, footprint, maxAngle) {
 }
 
 /// make_peak_level: a level's peaks for ibl_prefilter_peaks (the split's peaks of an n0-texel level 0
-/// with `sourceLevels` mips, merged at peakMergeMip or coarser (maxLevelPeaks), energies pre-scaled by alpha^2 / (4 pi
+/// with `sourceLevels` mips, merged at peakMergeMip, one mip coarser above maxLevelPeaks, energies pre-scaled by alpha^2 / (4 pi
 /// integral K)): { peak_count, peaks: Float32Array (x, y, z, er, eg, eb per peak), a2, g1 }.
 export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults) {
     const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false };
@@ -376,10 +376,12 @@ export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = 
     const norm = 2 * Math.PI * radialCdf(r, weight).total;
     if (!(norm > 0)) return none;
     const scale = a2 / (4 * Math.PI * norm);
-    // At most maxLevelPeaks merged peaks: merged at coarser mips until they are that many.
+    // More than maxLevelPeaks merged peaks: merged one mip coarser (a texel at most maxMergeAngle).
     let mip = peakMergeMip(r, n0, sourceLevels - 1, opt.footprint, opt.maxMergeAngle);
     let merged = mergePeaks(peaks, mip);
-    while (opt.maxLevelPeaks > 0 && merged.length > opt.maxLevelPeaks && mip < sourceLevels - 1) merged = mergePeaks(peaks, ++mip);
+    if (opt.maxLevelPeaks > 0 && merged.length > opt.maxLevelPeaks && mip < sourceLevels - 1 && (n0 >> (mip + 1)) >= 1 &&
+        2 / (n0 >> (mip + 1)) <= opt.maxMergeAngle)
+        merged = mergePeaks(peaks, ++mip);
     const out = new Float32Array(6 * merged.length);
     merged.forEach((p, j) => {
         out.set(p.dir, 6 * j);

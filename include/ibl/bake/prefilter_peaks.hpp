@@ -34,10 +34,11 @@
 //     T = max(ratio * mean luminance, luminance of the (max_peaks + 1)-th brightest texel),
 //
 // so a source with nothing above ratio times its mean has no peaks and filters exactly as without
-// the split, and the cost of the exact part is bounded: at most max_level_peaks (128) kernel
-// evaluations per output texel (a level with more merged peaks merges them at coarser mips until
-// it has that many; peaks behind a row's hemisphere, and the faintest within the row cut, are
-// skipped per row). Each evaluation is about ten float operations, vectorised over a face row.
+// the split, and the cost of the exact part is bounded: at most max_peaks kernel evaluations per
+// output texel, and fewer after the merge: a level with more than max_level_peaks (128) merged
+// peaks merges them one mip coarser (merged texels up to twice the footprint rule's, at most
+// max_merge_angle); peaks behind
+// a row's hemisphere, and the faintest within the row cut, are skipped per row. Each evaluation is about ten float operations, vectorised over a face row.
 // Many peaks mean an extended bright region, each of its texels faint next to the whole (the
 // courtyard's 1024 brightest texels carry 0.4 % of its energy); there the coarser merge changes no
 // level's error measurably, while lowering max_peaks would leave a studio's lamps in the tap set
@@ -91,8 +92,9 @@ struct peak_split_options {
     /// row's darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
     /// peak that is in front of some texel of the row (the GPU filter's sum).
     double cut = 1e-3;
-    /// At most this many merged peaks per output level (0: no limit): the peaks of a level with
-    /// more are merged at coarser mips until they are this many.
+    /// A level with more merged peaks than this (0: no limit) merges them one mip coarser (its
+    /// merged texels up to twice the footprint rule's, at most max_merge_angle): many peaks are
+    /// an extended bright region.
     std::uint32_t max_level_peaks = 128;
 };
 
@@ -406,7 +408,11 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
     const double scale = a2 / (4.0 * pi_v<double> * norm);
     int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
     std::vector<cube_peak> merged = merge_cube_peaks(peaks, mip);
-    while (max_level_peaks > 0 && merged.size() > max_level_peaks && mip < source_levels - 1) merged = merge_cube_peaks(peaks, ++mip);
+    // Too many: one mip coarser at most (merged texels up to twice the footprint rule's, never
+    // above max_angle: a rough level's horizon cut is what that bound protects).
+    if (max_level_peaks > 0 && merged.size() > max_level_peaks && mip < source_levels - 1 && (n0 >> (mip + 1)) >= 1 &&
+        2.0 / double(n0 >> (mip + 1)) <= max_angle)
+        merged = merge_cube_peaks(peaks, ++mip);
     for (const cube_peak& p : merged) {
         pl.px.push_back(p.dir.x), pl.py.push_back(p.dir.y), pl.pz.push_back(p.dir.z);
         pl.er.push_back(float(p.energy.x * scale)), pl.eg.push_back(float(p.energy.y * scale)),
