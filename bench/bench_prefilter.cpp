@@ -188,6 +188,20 @@ void BM_irradiance(benchmark::State& state) {
     state.counters["ratio"] = m.max_ratio;
 }
 
+/// The largest difference of a prefilter_update's finished chain from the one-shot prefilter of
+/// the same source and options (0: bit for bit).
+double max_abs_vs_oneshot(const ibl::prefilter_update<>& up, const ibl::cubemap<float>& src, const ibl::prefilter_options& o) {
+    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::thread_executor{2});
+    double diff = 0.0;
+    for (int l = 0; l < ref.levels(); ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < ref.size(l); ++y)
+                for (int x = 0; x < ref.size(l); ++x)
+                    for (int c = 0; c < 3; ++c)
+                        diff = std::max(diff, double(std::abs(up.result()->texel(f, x, y, l)[c] - ref.texel(f, x, y, l)[c])));
+    return diff;
+}
+
 /// A dynamic probe's slice: one prefilter_update::step of a budget of 2^k taps (k = range(1)) on
 /// the 256^2 source with the default options of filtered importance sampling (range(2) = 0) or of
 /// the fast filter (1), one thread, the pass restarted when it finishes. Counters: taps per call,
@@ -225,14 +239,7 @@ void BM_prefilter_update_step(benchmark::State& state) {
         ++calls;
     }
     up.finish();
-    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::thread_executor{2});
-    double diff = 0.0;
-    for (int l = 0; l < ref.levels(); ++l)
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < ref.size(l); ++y)
-                for (int x = 0; x < ref.size(l); ++x)
-                    for (int c = 0; c < 3; ++c)
-                        diff = std::max(diff, double(std::abs(up.result()->texel(f, x, y, l)[c] - ref.texel(f, x, y, l)[c])));
+    const double diff = max_abs_vs_oneshot(up, src, o);
     state.counters["taps_per_call"] = double(taps) / double(std::max<std::uint64_t>(calls, 1));
     state.counters["taps_per_s"] = benchmark::Counter(double(taps), benchmark::Counter::kIsRate);
     state.counters["max_abs_vs_oneshot"] = diff;
@@ -275,14 +282,7 @@ void BM_prefilter_update_time(benchmark::State& state) {
         ++calls;
     }
     up.finish();
-    const ibl::specular_chain ref = ibl::prefilter(src, o, ibl::thread_executor{2});
-    double diff = 0.0;
-    for (int l = 0; l < ref.levels(); ++l)
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < ref.size(l); ++y)
-                for (int x = 0; x < ref.size(l); ++x)
-                    for (int c = 0; c < 3; ++c)
-                        diff = std::max(diff, double(std::abs(up.result()->texel(f, x, y, l)[c] - ref.texel(f, x, y, l)[c])));
+    const double diff = max_abs_vs_oneshot(up, src, o);
     const double b = std::chrono::duration<double>(budget).count();
     double mean = 0.0;
     for (const double t : times) mean += t / double(times.size());
