@@ -22,7 +22,8 @@ SwiftShader's WebGL2), compared with the C++.
            reconstructs it from them) and compares every texel of every convolved level with the C++ chain
            (ibl::prefilter, method fast, peaks.cut = 0) within half-float rounding: |GLSL - C++|
            <= 2^-11 |C++| per value. Then the viewer's own inputs (tools/viewer/refilter.js: the
-           split, the base's packing, the taps, the peak lists, the band choice and projection) against the C++ ones, and the
+           split, the base's packing, the taps, the peak lists, the band choice and projection, the
+           projection also as a GPU pass: sh_project.frag.glsl) against the C++ ones, and the
            levels rendered from them against the C++ chain (1e-4 relative).
   refilter bakes the built-in sky with the fast filter into a float chain (--size N --prefilter
            fast --ktx2-format rgba32f; ctest: N = 64) and lets the viewer re-filter it live (Renderer.refilter,
@@ -614,6 +615,13 @@ def compare_prefilter(fixtures, result):
         if lv["sh_bands"] > 0:
             ok = ok and d.get("face") == lv["projection_face"] and d.get("cosine_max_rel", 1) <= 1e-5 and \
                 d.get("sine_max_rel", 1) <= 1e-5 and d.get("recurrence_max_rel", 1) <= 1e-7
+    # The same projection on the GPU (sh_project.frag.glsl, ibl_prefilter_sh_project: float sums in
+    # row order) made into the levels' textures: the same bounds.
+    for lv, d in zip(fixtures["levels"], result["sh_gpu"]):
+        print(f"GPU sh projection, level {lv['level']} ({lv['weight']}): {d}")
+        if lv["sh_bands"] > 0:
+            ok = ok and d.get("bands") == lv["sh_bands"] and d.get("face") == lv["projection_face"] and \
+                d.get("cosine_max_rel", 1) <= 1e-5 and d.get("sine_max_rel", 1) <= 1e-5
     by_level = {(lv["level"], lv["weight"]): lv for lv in result["js_levels"]}
     for lv in fixtures["levels"]:
         got = by_level.get((lv["level"], lv["weight"]))

@@ -371,6 +371,47 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
     return made;
 }
 
+/// The projection of the packed source onto `bands` bands on the GPU (sh_project.frag.glsl,
+/// ibl_prefilter_sh_project), from the texture on unit 0 holding `packed` (refilter.js packSource,
+/// `width` texels a row): the level refilter.js shProject projects, one pass of sh_pair_count x 12
+/// texels, read back and summed over the faces in double. Returns what shProject returns ({ bands,
+/// face, coef, unit }, 6 per pair), for refilter.js shLevel.
+function gpuShProject(gl, program, vao, packed, bands) {
+    const cap = Math.max(16, 2 * bands);
+    let lv = packed.levels[packed.levels.length - 1];
+    for (const l of packed.levels) if (l.n <= cap) { lv = l; break; }
+    const pairs = (bands * (bands + 1)) / 2;
+    gl.useProgram(program);
+    gl.bindVertexArray(vao);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_src'), 0);
+    gl.uniform4i(gl.getUniformLocation(program, 'u_level'), lv.n, lv.stride, lv.faceStride, lv.offset);
+    gl.uniform1i(gl.getUniformLocation(program, 'u_bands'), bands);
+    const fb = gl.createFramebuffer(), tex = gl.createTexture();
+    gl.activeTexture(gl.TEXTURE7); // on no sampler's unit
+    gl.bindTexture(gl.TEXTURE_2D, tex);
+    gl.texImage2D(gl.TEXTURE_2D, 0, gl.RGBA32F, pairs, 12, 0, gl.RGBA, gl.FLOAT, null);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+    gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, tex, 0);
+    gl.drawBuffers([gl.COLOR_ATTACHMENT0]);
+    gl.viewport(0, 0, pairs, 12);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    const px = new Float32Array(4 * pairs * 12);
+    gl.readBuffer(gl.COLOR_ATTACHMENT0);
+    gl.readPixels(0, 0, pairs, 12, gl.RGBA, gl.FLOAT, px);
+    gl.bindFramebuffer(gl.FRAMEBUFFER, null);
+    gl.deleteFramebuffer(fb);
+    gl.deleteTexture(tex);
+    const coef = new Float64Array(6 * pairs), unit = new Float64Array(6 * pairs);
+    for (let f = 0; f < 6; ++f)
+        for (let p = 0; p < pairs; ++p)
+            for (let half = 0; half < 2; ++half) {
+                const at = 4 * ((2 * f + half) * pairs + p);
+                for (let c = 0; c < 3; ++c) coef[6 * p + 3 * half + c] += px[at + c];
+                for (let c = 0; c < 3; ++c) unit[6 * p + 3 * half + c] += px[at + 3];
+            }
+    return { bands, face: lv.n, coef, unit };
+}
+
 class Renderer {
     constructor(canvas, glsl, fragment) {
         const gl = canvas.getContext('webgl2', { antialias: false, preserveDrawingBuffer: true, alpha: false, premultipliedAlpha: false });
@@ -427,17 +468,19 @@ class Renderer {
     /// at the level's roughness from report.json, the bake's samples and reads when it was filtered
     /// by the fast filter, else the fast filter's default plan (64 x 4^(v - 1) samples at virtual
     /// level v, nearest-level reads), the chain's LD weight, its merged peaks and its coarse tail, or, for a level
-    /// whose kernel needs at most 24 bands, its spherical-harmonic reconstruction) and renders
+    /// whose kernel needs at most 24 bands, its spherical-harmonic reconstruction from the source's
+    /// projection, itself a GPU pass: sh_project.frag.glsl) and renders
     /// every face of every level into the chain texture, coarse to fine (a level's coarse tail reads
     /// the next level back from the GPU and packs it). Returns { prepare_ms (split, packing, taps and peaks, CPU),
     /// gpu_ms (the passes, to gl.finish), levels, peaks (level-0 peaks) }.
-    refilter(prefilterFragment, shapesText) {
+    refilter(prefilterFragment, shapesText, projectFragment) {
         const gl = this.gl, bake = this.bake, chain = bake.chain;
         const spec = bake.report && bake.report.specular;
         if (!spec || !Array.isArray(spec.levels)) throw new Error('re-filtering needs report.json (the levels\' roughness)');
         if (chain.vkFormat !== 97 && chain.vkFormat !== 109) throw new Error('re-filtering needs an rgba16f or rgba32f chain (--ktx2-format)');
         if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('re-filtering needs EXT_color_buffer_float');
         if (!this.prefilterProgram) this.prefilterProgram = compile(gl, VERTEX, HEADER + this.glsl + '\n' + prefilterFragment);
+        if (!this.shProjectProgram) this.shProjectProgram = compile(gl, VERTEX, HEADER + this.glsl + '\n' + projectFragment);
         const t0 = performance.now();
         const l0 = chain.levels[0], n0 = l0.size, half = chain.vkFormat === 97;
         const rgbOf = (f, x, y) => {
@@ -453,13 +496,13 @@ class Renderer {
         // The rough levels by spherical harmonics (sh_rough_options' defaults): the bands each level
         // needs, and the split's base projected once onto the most of them.
         const bands = spec.levels.map((lv, k) => (convolved(k) ? shBands(lv.roughness, weight) : 0));
-        const most = Math.max(0, ...bands), proj = most > 0 ? shProject(packed, most) : null;
+        const most = Math.max(0, ...bands);
         spec.levels.forEach((lv, k) => {
             if (!convolved(k)) return;
             const peaks = makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight);
             if (bands[k] > 0) { // no taps and no coarse tail
                 plan.push({ k, n: chain.levels[k].size, count: 0, taps: new Float32Array(0), info: new Float32Array(0), factor: 0,
-                            tail_share: 0, ...shLevel(proj, lv.roughness, weight, bands[k]), ...peaks });
+                            tail_share: 0, roughness: lv.roughness, sh_bands: bands[k], sh: null, ...peaks });
                 return;
             }
             // The bake's own samples and reads when it was filtered by the fast filter, else the fast
@@ -484,6 +527,10 @@ class Renderer {
             };
         const t1 = performance.now();
         const srcTex = packedTexture(gl, packed.data, 4096);
+        if (most > 0) { // the projection on the GPU (ibl_prefilter_sh_project), then each SH level's texture
+            const proj = gpuShProject(gl, this.shProjectProgram, this.vao, packed, most);
+            for (const lv of plan) if (lv.sh_bands > 0) Object.assign(lv, shLevel(proj, lv.roughness, weight, lv.sh_bands));
+        }
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
         const needed = (lv) => plan.some((p) => p.k === lv.k - 1 && p.tail_share > 0);
@@ -797,8 +844,14 @@ async function runPrefilterTest() {
         if (most > 0) projections.set(w, shProject(js, most));
     }
     const jsSh = fx.levels.map((lv, i) => shLevel(projections.get(lv.weight), lv.roughness, lv.weight, jsBands[i]));
-    const shDiff = fx.levels.map((lv, i) => {
-        const got = jsSh[i], proj = projections.get(lv.weight);
+    // The same projection on the GPU (sh_project.frag.glsl) from the viewer's packing.
+    const projectProgram = compile(gl, VERTEX, HEADER + (await libraryGlsl()) + '\n' + (await fetchText('sh_project.frag.glsl')));
+    packedTexture(gl, js.data, fx.width);
+    const gpuProjections = new Map();
+    for (const [w, pr] of projections) gpuProjections.set(w, gpuShProject(gl, projectProgram, vao, js, pr.bands));
+    const gpuSh = fx.levels.map((lv, i) => shLevel(gpuProjections.get(lv.weight), lv.roughness, lv.weight, jsBands[i]));
+    const shDiffOf = (levelsSh, projs) => fx.levels.map((lv, i) => {
+        const got = levelsSh[i], proj = projs.get(lv.weight);
         const d = { bands: got.sh_bands, expected_bands: lv.sh_bands, face: proj ? proj.face : 0, expected_face: lv.projection_face };
         if (got.sh.length !== lv.sh.length) return { ...d, size: got.sh.length, expected_size: lv.sh.length };
         const pairs = got.sh.length / 12, rel = [0, 0, 0];
@@ -810,6 +863,7 @@ async function runPrefilterTest() {
         }
         return { ...d, cosine_max_rel: rel[0], sine_max_rel: rel[1], recurrence_max_rel: rel[2] };
     });
+    const shDiff = shDiffOf(jsSh, projections), shGpuDiff = shDiffOf(gpuSh, gpuProjections);
     const peaksDiff = fx.levels.map((lv, i) => {
         const p = jsPeaks[i];
         if (p.peak_count !== lv.peak_count || p.g1 !== lv.g1) return { count: p.peak_count, expected: lv.peak_count };
@@ -874,7 +928,7 @@ async function runPrefilterTest() {
     const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i],
                                                         ...jsSh[i] })));
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
-                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff, sh: shDiff,
+                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff, sh: shDiff, sh_gpu: shGpuDiff,
                  source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });
 }
 
@@ -897,7 +951,8 @@ async function runRefilterTest() {
             const n = chain.levels[k].size;
             gl.texSubImage2D(gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, k, 0, 0, n, n, gl.RGBA, gl.FLOAT, new Float32Array(4 * n * n));
         }
-    const t = r.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
+    const t = r.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'),
+                         await fetchText('sh_project.frag.glsl'));
     const fb = gl.createFramebuffer();
     gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
     gl.readBuffer(gl.COLOR_ATTACHMENT0);
@@ -1042,7 +1097,8 @@ async function runViewer() {
     const refilter = async () => {
         if (!ready) return;
         try {
-            const t = renderer.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
+            const t = renderer.refilter(await fetchText('prefilter.frag.glsl'), await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'),
+                                        await fetchText('sh_project.frag.glsl'));
             el('refilter_v').textContent = `${t.levels} levels, ${t.peaks} peaks: ${t.gpu_ms.toFixed(1)} ms GPU + ${t.prepare_ms.toFixed(1)} ms CPU`;
             redraw();
         } catch (e) {

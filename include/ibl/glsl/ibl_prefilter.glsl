@@ -170,6 +170,68 @@ vec3 ibl_prefilter_sh(sampler2D sh, int bands, vec3 dir) {
     return norm > 0.0 ? v / norm : v;
 }
 
+// The projection behind those levels on the GPU (bake/prefilter_sh.hpp sh_projection): the sums
+// over the n x n texels of face `face` of one level of the packed source (its n, stride, face
+// stride and offset as in the taps' texture) of radiance x exact solid angle x Q_l^m(z) Re (sine:
+// Im) (x + i y)^m, RGB, and in alpha the same sum for a constant 1 (the norm's). Pair (l, m) of
+// `bands` as ibl_prefilter_sh's columns (the recurrence's constants computed here). A renderer
+// runs it as one pass of sh_pair_count x 12 texels (a column per pair; rows: six faces, cosine then
+// sine) and adds the six faces: the coefficients ibl_prefilter_sh's texture is built from (times
+// k_l, and 2 for m > 0), without reading the source back. Float sums in row order: the C++ sums in
+// float lanes and reduces in double, so the two agree to float rounding (the browser test: within
+// 1e-5 of the largest coefficient).
+float ibl_cube_texel_solid_angle(int x, int y, int n) {
+    float inv = 2.0 / float(n);
+    float u0 = float(x) * inv - 1.0, u1 = float(x + 1) * inv - 1.0;
+    float v0 = float(y) * inv - 1.0, v1 = float(y + 1) * inv - 1.0;
+    // F(u, v) = atan(u v / sqrt(u^2 + v^2 + 1)) at the four corners: the one-argument atan (the
+    // denominator is at least 1). The two-argument form is the C++'s, but SwiftShader returns pi
+    // for atan(-0.0, x > 0) (a corner on a face's middle line), which made one texel a face negative.
+    float a = atan(u1 * v1 / sqrt(u1 * u1 + v1 * v1 + 1.0)), b = atan(u0 * v1 / sqrt(u0 * u0 + v1 * v1 + 1.0));
+    float c = atan(u1 * v0 / sqrt(u1 * u1 + v0 * v0 + 1.0)), d = atan(u0 * v0 / sqrt(u0 * u0 + v0 * v0 + 1.0));
+    return a - b - c + d;
+}
+// Q_l^m(z) of the normalised associated-Legendre recurrence (ibl_prefilter_sh's, bake/prefilter_sh.hpp).
+float ibl_sh_q(int l, int m, float z) {
+    float q = 0.28209479177387814;
+    for (int k = 1; k <= m; ++k) q *= sqrt(float(2 * k + 1) / float(2 * k));
+    float q1 = q, q2 = 0.0;
+    for (int j = m + 1; j <= l; ++j) {
+        float fl = float(j), fm = float(m);
+        float ra = sqrt((4.0 * fl * fl - 1.0) / (fl * fl - fm * fm));
+        float rb = j > m + 1 ? sqrt(((fl - 1.0) * (fl - 1.0) - fm * fm) / (4.0 * (fl - 1.0) * (fl - 1.0) - 1.0)) : 0.0;
+        float qn = ra * (z * q1 - rb * q2);
+        q2 = q1;
+        q1 = qn;
+    }
+    return q1;
+}
+// Re (sine: Im) (x + i y)^m.
+float ibl_sh_phase(vec3 d, int m, bool sine) {
+    float cr = 1.0, ci = 0.0;
+    for (int k = 1; k <= m; ++k) {
+        float nr = cr * d.x - ci * d.y, ni = cr * d.y + ci * d.x;
+        cr = nr;
+        ci = ni;
+    }
+    return sine ? ci : cr;
+}
+vec4 ibl_prefilter_sh_project(sampler2D src, ivec4 level, int face, int l, int m, bool sine) {
+    int n = level.x, st = level.y, fs = level.z, off = level.w;
+    vec4 acc = vec4(0.0);
+    for (int y = 0; y < n; ++y) {
+        vec4 line = vec4(0.0);
+        for (int x = 0; x < n; ++x) {
+            vec3 dir = ibl_cube_texel_direction(face, x, y, n);
+            float weight = ibl_cube_texel_solid_angle(x, y, n) * ibl_sh_q(l, m, dir.z) * ibl_sh_phase(dir, m, sine);
+            vec3 radiance = ibl_packed_texel(src, off + face * fs + (y + 1) * st + (x + 1)).rgb;
+            line += vec4(radiance * weight, weight);
+        }
+        acc += line;
+    }
+    return acc;
+}
+
 // The coarse tail (prefilter_options::coarse_tail, detail::add_coarse_tail_row): share times the
 // next level (packed as above, n_next x n_next faces) read bilinearly at the centre of texel
 // (x, y) of face `face` of the n x n level being filtered: cubemap::bilinear(face, s, t) with
