@@ -57,8 +57,9 @@
 // row's peaks (as its finish), like a mirror level's rows.
 //
 // Time budgets. step_for(duration) runs step in slices, each given half of the time left at the
-// rate measured by the earlier slices and calls (seconds a tap, seconds_per_tap()), reading the
-// clock between slices only. A slice whose true rate is within 2x of the estimate ends within the
+// rate measured by the earlier slices and calls (seconds a tap, seconds_per_tap(): slices of at
+// least 1024 taps move it in log space, at most 4x a slice, so a descheduled slice is forgotten
+// within a few calls), reading the clock between slices only. A slice whose true rate is within 2x of the estimate ends within the
 // time left, so the call ends within its budget unless one unit alone is dearer than what is left;
 // the rate differs by phase (a row's taps run on one thread, whole rows through the executor; a
 // row's cost depends on where its taps read) by up to 1.7x on one thread, which the halving absorbs
@@ -79,6 +80,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <optional>
@@ -156,17 +158,23 @@ public:
             const std::uint64_t t = step_units(k, ex, spent == 0); // the first slice makes progress
             const clock::time_point t1 = clock::now();
             elapsed = std::chrono::duration<double>(t1 - start).count();
-            if (t > 0) { // the rate: slices of 2^16 taps and more replace it, smaller ones move it by their share
+            if (t >= 1024) { // the rate, from slices long enough for the clock (a few microseconds)
                 const double rate = std::chrono::duration<double>(t1 - t0).count() / double(t);
-                const double a = std::min(1.0, double(t) / 65536.0);
-                if (rate > 0.0) seconds_per_tap_ = (1.0 - a) * seconds_per_tap_ + a * rate;
+                if (rate > 0.0 && std::isfinite(rate)) {
+                    // In log space, a slice of 2^16 taps or more all the way, a shorter one by its
+                    // share but at least an eighth; a factor of 4 at most a slice, so that one
+                    // descheduled slice neither stalls the next calls nor takes long to forget.
+                    const double a = std::clamp(double(t) / 65536.0, 0.125, 1.0);
+                    seconds_per_tap_ *= std::pow(std::clamp(rate / seconds_per_tap_, 0.25, 4.0), a);
+                }
             }
             spent += t;
             if (t == 0) break; // the next unit is dearer than the slice
         }
         return spent;
     }
-    /// The rate step_for plans with (seconds a tap, as measured by its calls so far).
+    /// The rate step_for plans with (seconds a tap, as measured by its calls so far: slices of at
+    /// least 1024 taps move it in log space, by at most a factor of 4 a slice).
     double seconds_per_tap() const noexcept { return seconds_per_tap_; }
 
     /// Runs the rest of the pass (no budget).
