@@ -37,8 +37,8 @@
 // the split, and the cost of the exact part is bounded: at most max_peaks kernel evaluations per
 // output texel, and fewer after the merge: a level with more than max_level_peaks (128) merged
 // peaks merges them one mip coarser (merged texels up to twice the footprint rule's, at most
-// max_merge_angle); peaks behind
-// a row's hemisphere, and the faintest within the row cut, are skipped per row. Each evaluation is about ten float operations, vectorised over a face row.
+// max_merge_angle); peaks behind a row's hemisphere, and the faintest within the row cut, are
+// skipped per row. Each evaluation is about ten float operations, vectorised over a face row.
 // Many peaks mean an extended bright region, each of its texels faint next to the whole (the
 // courtyard's 1024 brightest texels carry 0.4 % of its energy); there the coarser merge changes no
 // level's error measurably, while lowering max_peaks would leave a studio's lamps in the tap set
@@ -485,7 +485,8 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
             if (const int b = bucket_of(v); b >= 0) sum[b] += double(v);
         double skipped = 0.0;
         int first_kept = peak_cut_buckets; // buckets >= first_kept are skipped
-        for (int b = peak_cut_buckets - 1; b >= 0 && skipped + sum[b] <= double(budget); --b) skipped += sum[b], first_kept = b;
+        for (int b = peak_cut_buckets - 1; b >= 0 && skipped + sum[b] <= double(budget); --b)
+            skipped += sum[b], first_kept = b;
         std::size_t k = 0;
         for (std::size_t i = 0; i < live.size(); ++i) {
             const int b = bucket_of(bound[i]);
