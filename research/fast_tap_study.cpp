@@ -280,15 +280,13 @@ int main(int argc, char** argv) {
         for (int l = 1; l < chain_levels; ++l) {
             const double r = level_r(l);
             auto& rl = refs[std::size_t(l)];
-            rl = ld_study::level_texels(l, base_size >> l, texels);
+            rl = ld_study::level_refs(cube, 0, l, base_size >> l, texels, r, w, ex);
             const std::vector<dvec3> dirs = ld_study::directions(rl);
-            const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), r, w, ex);
             sum_level[std::size_t(l)] = ibl::ld_texel_sum_level(cube, r);
             const std::vector<dvec3> coarse = ibl::ld_texel_sum(cube, sum_level[std::size_t(l)], std::span<const dvec3>(dirs), r, w, ex);
             std::vector<std::array<dvec3, 3>> check(rl.size());
             ex(rl.size(), [&](std::size_t b, std::size_t e) {
                 for (std::size_t i = b; i < e; ++i) {
-                    rl[i].ref = exact[i];
                     check[i] = {ibl::reference_ld(map, dirs[i], r, 2048, w), ibl::reference_ld(map, dirs[i], r, 8192, w), coarse[i]};
                 }
             });

@@ -14,6 +14,7 @@
 #include <ibl/core/executor.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
+#include <ibl/reference/ld_irradiance.hpp>
 
 #include "io/image_io.hpp"
 #include "study_envs.hpp"
@@ -80,6 +81,18 @@ inline std::vector<dvec3> directions(const std::vector<texel_ref>& refs) {
     for (const texel_ref& t : refs) d.push_back(t.dir);
     return d;
 }
+/// `count` random texels of level l (face n) with their reference: the exact LD of `cube` at
+/// roughness r and weight w, ibl::ld_texel_sum over the cube's level `sum_level` (0: every texel
+/// of level 0; ibl::ld_texel_sum_level: the coarser level ibl-bake's check sums).
+inline std::vector<texel_ref> level_refs(const ibl::cubemap<float>& cube, int sum_level, int l, int n, int count, double r,
+                                         ibl::ld_weight w, ibl::thread_executor& ex) {
+    std::vector<texel_ref> refs = level_texels(l, n, count);
+    const std::vector<dvec3> dirs = directions(refs);
+    const std::vector<dvec3> ld = ibl::ld_texel_sum(cube, sum_level, std::span<const dvec3>(dirs), r, w, ex);
+    for (std::size_t i = 0; i < refs.size(); ++i) refs[i].ref = ld[i];
+    return refs;
+}
+
 /// Relative RMSE of luminance of texel(f, x, y) against the references.
 template <class TexelFn> double rel_rmse(const std::vector<texel_ref>& refs, TexelFn&& texel) {
     double s = 0.0;

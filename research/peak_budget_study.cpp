@@ -42,14 +42,9 @@ void run_study(const std::string& name, const ibl::cubemap<float>& src, const st
     const ibl::prefilter_options base_opt;
     const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(base_opt, size);
     std::vector<std::vector<ld_study::texel_ref>> refs(plan.size());
-    for (std::size_t l = 1; l < plan.size(); ++l) {
-        refs[l] = ld_study::level_texels(int(l), std::max(1, size >> l), texels);
-        const std::vector<ld_study::dvec3> dirs = ld_study::directions(refs[l]);
-        const std::vector<ld_study::dvec3> ld = ibl::ld_texel_sum(src, ibl::ld_texel_sum_level(src, plan[l].roughness),
-                                                                  std::span<const ld_study::dvec3>(dirs), plan[l].roughness,
-                                                                  base_opt.weight, ex);
-        for (std::size_t i = 0; i < ld.size(); ++i) refs[l][i].ref = ld[i];
-    }
+    for (std::size_t l = 1; l < plan.size(); ++l)
+        refs[l] = ld_study::level_refs(src, ibl::ld_texel_sum_level(src, plan[l].roughness), int(l), std::max(1, size >> l), texels,
+                                       plan[l].roughness, base_opt.weight, ex);
     std::printf("\n%s, %d^2, %zu levels\n\n", name.c_str(), size, plan.size());
     std::printf("| filter | threshold / mean | level-1 peaks | time | levels 1-%zu rel RMSE |\n|---|---|---|---|---|\n", plan.size() - 1);
     for (const variant& v : variants) {

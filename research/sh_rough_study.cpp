@@ -86,13 +86,7 @@ int main(int argc, char** argv) {
     for (const std::string& file : args.files) {
         const ibl::cubemap<float> cube = ld_study::source_cube(ld_study::load_latlong(file), base_size, ex);
         std::vector<std::vector<texel_ref>> refs(chain_levels);
-        for (int l = 1; l < chain_levels; ++l) {
-            auto& rl = refs[std::size_t(l)];
-            rl = ld_study::level_texels(l, base_size >> l, texels);
-            const std::vector<dvec3> dirs = ld_study::directions(rl);
-            const std::vector<dvec3> exact = ibl::ld_texel_sum(cube, 0, std::span<const dvec3>(dirs), level_r(l), w, ex);
-            for (std::size_t i = 0; i < rl.size(); ++i) rl[i].ref = exact[i];
-        }
+        for (int l = 1; l < chain_levels; ++l) refs[std::size_t(l)] = ld_study::level_refs(cube, 0, l, base_size >> l, texels, level_r(l), w, ex);
         std::printf("\n%s: 256^2 source, levels 2-5 of a 6-level chain (r = l/5), n.l weight, %d texels per level; "
                     "reference ibl::ld_texel_sum over level 0\n\n",
                     file.substr(file.find_last_of('/') + 1).c_str(), texels);
