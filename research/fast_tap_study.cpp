@@ -150,9 +150,9 @@ struct chain_result {
     double taps = 0;
 };
 
-constexpr int chain_levels = 6;
-constexpr int base_size = 256;
-double level_r(int l) { return double(l) / double(chain_levels - 1); }
+using ld_study::base_size;
+using ld_study::chain_levels;
+using ld_study::level_r;
 std::uint32_t doubling(std::uint32_t n0, int l) { return ibl::doubling_prefilter_samples(n0, l); }
 
 chain_result run_design(const design& d, const ibl::cubemap<float>& cube, const std::vector<std::vector<texel_ref>>& refs,

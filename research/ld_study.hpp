@@ -45,6 +45,11 @@ inline args parse(int argc, char** argv) {
     return a;
 }
 
+/// The chain both studies filter: a 256^2 source to 6 levels at r = l / 5 (ibl-bake's automatic plan).
+inline constexpr int chain_levels = 6;
+inline constexpr int base_size = 256;
+inline double level_r(int l) { return double(l) / double(chain_levels - 1); }
+
 /// A lat-long HDRI with its borders.
 inline ibl::latlong<float> load_latlong(const std::string& file) {
     const ibl_bake::image_rgb32f img = ibl_bake::read_latlong(file, {});

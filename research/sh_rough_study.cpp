@@ -69,9 +69,9 @@ void sh_eval(int B, const dvec3& d, double* y) {
     }
 }
 
-constexpr int chain_levels = 6;
-constexpr int base_size = 256;
-double level_r(int l) { return double(l) / double(chain_levels - 1); }
+using ld_study::base_size;
+using ld_study::chain_levels;
+using ld_study::level_r;
 } // namespace
 
 int main(int argc, char** argv) {
