@@ -453,6 +453,14 @@ export function shBands(roughness, weight, opt = shDefaults) {
     return 0;
 }
 
+/// The packed level the projection for B bands reads (detail::sh_projection_level): the finest
+/// whose face is at most max(16, 2 B), else the coarsest.
+export function shProjectionLevel(packed, bands) {
+    const cap = Math.max(16, 2 * bands);
+    for (const l of packed.levels) if (l.n <= cap) return l;
+    return packed.levels[packed.levels.length - 1];
+}
+
 /// Index of pair (l, m) in the kernels' order for B bands (m outer, l = m .. B - 1 inner).
 const pairIndex = (B, l, m) => m * B - (m * (m - 1)) / 2 + (l - m);
 
@@ -461,12 +469,17 @@ const pairIndex = (B, l, m) => m * B - (m * (m - 1)) / 2 + (l - m);
 /// and sine sums of R G B over the texels (radiance x exact solid angle x Q_l^m Re / Im (x + i y)^m),
 /// and the same of a constant 1 (the norm's). In double. { bands, face, coef, unit } (6 per pair).
 export function shProject(packed, bands) {
-    const cap = Math.max(16, 2 * bands);
-    let lv = packed.levels[packed.levels.length - 1];
-    for (const l of packed.levels) if (l.n <= cap) { lv = l; break; }
+    const lv = shProjectionLevel(packed, bands);
     const n = lv.n, pairs = (bands * (bands + 1)) / 2;
     const coef = new Float64Array(6 * pairs), unit = new Float64Array(6 * pairs);
     const mm = Array.from({ length: bands }, (_, m) => (m > 0 ? Math.sqrt((2 * m + 1) / (2 * m)) : 1));
+    // the recurrence's a_lm, b_lm at l * bands + m (l > m; b = 0 at l = m + 1)
+    const ra = new Float64Array(bands * bands), rb = new Float64Array(bands * bands);
+    for (let m = 0; m < bands; ++m)
+        for (let l = m + 1; l < bands; ++l) {
+            ra[l * bands + m] = Math.sqrt((4 * l * l - 1) / (l * l - m * m));
+            rb[l * bands + m] = l > m + 1 ? Math.sqrt(((l - 1) * (l - 1) - m * m) / (4 * (l - 1) * (l - 1) - 1)) : 0;
+        }
     const q = new Float64Array(bands);
     for (let f = 0; f < 6; ++f)
         for (let y = 0; y < n; ++y)
@@ -482,11 +495,8 @@ export function shProject(packed, bands) {
                         cr = nr, ci = ni, qmm *= mm[m];
                     }
                     q[m] = qmm;
-                    for (let l = m + 1; l < bands; ++l) {
-                        const L = l, M = m, a = Math.sqrt((4 * L * L - 1) / (L * L - M * M));
-                        const b = l > m + 1 ? Math.sqrt(((L - 1) * (L - 1) - M * M) / (4 * (L - 1) * (L - 1) - 1)) : 0;
-                        q[l] = a * (dz * q[l - 1] - (l > m + 1 ? b * q[l - 2] : 0));
-                    }
+                    for (let l = m + 1; l < bands; ++l)
+                        q[l] = ra[l * bands + m] * (dz * q[l - 1] - (l > m + 1 ? rb[l * bands + m] * q[l - 2] : 0));
                     for (let l = m; l < bands; ++l) {
                         const p = 6 * pairIndex(bands, l, m), c = q[l] * cr, s = q[l] * ci;
                         for (let ch = 0; ch < 3; ++ch) coef[p + ch] += c * w[ch], coef[p + 3 + ch] += s * w[ch];

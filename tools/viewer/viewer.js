@@ -33,7 +33,7 @@
 // for Zstandard-supercompressed files (--ktx2-zstd N), the panel says so and nothing is drawn.
 
 import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
-import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel, shBands, shProject, shLevel } from './refilter.js';
+import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel, shBands, shProject, shProjectionLevel, shLevel } from './refilter.js';
 
 const params = new URLSearchParams(location.search);
 const testMode = params.get('test');
@@ -377,10 +377,7 @@ function prefilterPasses(gl, program, vao, levels, target, done = () => {}) {
 /// texels, read back and summed over the faces in double. Returns what shProject returns ({ bands,
 /// face, coef, unit }, 6 per pair), for refilter.js shLevel.
 function gpuShProject(gl, program, vao, packed, bands) {
-    const cap = Math.max(16, 2 * bands);
-    let lv = packed.levels[packed.levels.length - 1];
-    for (const l of packed.levels) if (l.n <= cap) { lv = l; break; }
-    const pairs = (bands * (bands + 1)) / 2;
+    const lv = shProjectionLevel(packed, bands), pairs = (bands * (bands + 1)) / 2;
     gl.useProgram(program);
     gl.bindVertexArray(vao);
     gl.uniform1i(gl.getUniformLocation(program, 'u_src'), 0);
