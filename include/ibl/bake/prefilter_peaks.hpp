@@ -481,17 +481,16 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
             std::frexp(v / budget, &e); // v / budget in [2^(e-1), 2^e), e <= 0
             return std::min(-e, peak_cut_buckets - 1);
         };
-        for (const float v : bound)
-            if (const int b = bucket_of(v); b >= 0) sum[b] += double(v);
+        std::vector<int> bucket(bound.size()); // -1: never skipped
+        for (std::size_t i = 0; i < bound.size(); ++i)
+            if ((bucket[i] = bucket_of(bound[i])) >= 0) sum[bucket[i]] += double(bound[i]);
         double skipped = 0.0;
         int first_kept = peak_cut_buckets; // buckets >= first_kept are skipped
         for (int b = peak_cut_buckets - 1; b >= 0 && skipped + sum[b] <= double(budget); --b)
             skipped += sum[b], first_kept = b;
         std::size_t k = 0;
-        for (std::size_t i = 0; i < live.size(); ++i) {
-            const int b = bucket_of(bound[i]);
-            if (b < 0 || b < first_kept) live[k++] = live[i];
-        }
+        for (std::size_t i = 0; i < live.size(); ++i)
+            if (bucket[i] < first_kept) live[k++] = live[i]; // -1 < first_kept too
         live.resize(k);
     }
     if (live.empty()) return;
