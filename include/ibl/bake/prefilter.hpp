@@ -651,7 +651,8 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
     detail::check_prefilter_work(opt, plan, base);
-    cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()));
+    // Every interior texel of every level is written below (by the workers, in place), then the borders.
+    cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()), detail::for_overwrite);
     // Coarse to fine when a level reads its coarse tail from the next (finished) level.
     std::optional<cubemap<float>> next; // the level after the one being computed, as its tail reads it
     if constexpr (requires { detail::pack_cube(env); }) {

@@ -41,6 +41,7 @@
 #include "../core/executor.hpp"
 #include "../core/frame.hpp"
 #include "../core/math.hpp"
+#include "../core/memory.hpp"
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
 #include "../env/cubemap.hpp"
@@ -63,10 +64,12 @@ struct packed_cube {
         float nf = 1.f;      ///< float(n)
     };
     std::vector<level> levels;
-    std::vector<float> data; ///< 4 floats per texel: R, G, B, 1
+    /// 4 floats per texel: R, G, B, 1; packed_layout leaves it to pack_cube_rows, which writes
+    /// every texel of every level, borders included (core/memory.hpp).
+    std::vector<float, default_init_allocator<float>> data;
 };
 
-/// The layout of c's packed copy: its levels and storage (texels 0); pack_cube_rows fills it.
+/// The layout of c's packed copy: its levels and storage (unwritten); pack_cube_rows fills it.
 template <class T> packed_cube packed_layout(const cubemap<T>& c) {
     packed_cube p;
     std::size_t total = 0;
@@ -80,7 +83,7 @@ template <class T> packed_cube packed_layout(const cubemap<T>& c) {
         total += std::size_t(6) * std::size_t(li.face_stride);
         p.levels.push_back(li);
     }
-    p.data.assign(4 * total, 0.f);
+    p.data.resize(4 * total);
     return p;
 }
 /// The work items of packing: the bordered rows (n + 2 per face) of every face of every level, in order.

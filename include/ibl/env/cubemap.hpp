@@ -52,6 +52,7 @@
 #include "../core/config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -65,6 +66,7 @@
 #include "../core/executor.hpp"
 #include "../core/limits.hpp"
 #include "../core/math.hpp"
+#include "../core/memory.hpp"
 #include "../core/vec.hpp"
 #include "cube_geometry.hpp"
 #include "detail/resample.hpp"
@@ -128,7 +130,16 @@ public:
     /// Throws std::invalid_argument for size < 1 or levels outside [0, full chain], and
     /// std::length_error for size > limits::max_face_size or more than limits::max_texels stored
     /// texels (cubemap_storage_texels), before allocating.
-    explicit cubemap(int size, int levels = 0) {
+    explicit cubemap(int size, int levels = 0) : cubemap(size, levels, detail::for_overwrite) {
+        std::fill(data_.begin(), data_.end(), vec3<T>(T(0)));
+    }
+
+    /// The same layout with every texel (borders included) left to the caller, who writes each
+    /// interior texel of every level and then calls update_borders() before any read: the
+    /// library's producers whose workers write the levels (prefilter), so that the memory is first
+    /// touched by the threads that fill it (core/memory.hpp). In builds without NDEBUG the
+    /// texels start as quiet NaN, so that a texel left unwritten shows in tests.
+    cubemap(int size, int levels, detail::for_overwrite_t) {
         const std::size_t total = cubemap_storage_texels(size, levels);
         if (levels == 0) levels = detail::full_chain_levels(size);
         std::size_t offset = 0;
@@ -143,7 +154,10 @@ public:
             levels_.push_back(li);
         }
         IBL_ASSERT(offset == total);
-        data_.assign(total, vec3<T>(T(0)));
+        data_.resize(total);
+#ifndef NDEBUG
+        std::fill(data_.begin(), data_.end(), vec3<T>(std::numeric_limits<T>::quiet_NaN()));
+#endif
     }
 
     /// Face size of a level. Safe for any level: a level outside [0, levels()) is clamped to the
@@ -461,7 +475,7 @@ private:
     }
 
     std::vector<level_info> levels_;
-    std::vector<vec3<T>> data_;
+    std::vector<vec3<T>, detail::default_init_allocator<vec3<T>>> data_;
     bool borders_dirty_ = false;
 };
 
