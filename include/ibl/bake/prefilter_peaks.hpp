@@ -52,6 +52,7 @@
 #if IBL_DETAIL_CXX20
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -455,20 +456,38 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
     float darkest = luminance(out[0]);
     for (int x = 1; x < n; ++x) darkest = std::min(darkest, luminance(out[x]));
     const float budget = pl.cut * std::max(darkest, pl.floor);
-    std::vector<std::uint32_t> live;
-    std::vector<float> bound; // per live peak: its largest contribution to the row (w(c) <= 1 for both weights)
-    live.reserve(pl.size());
-    bound.reserve(pl.size());
-    for (std::size_t j = 0; j < pl.size(); ++j) {
+    // Per-thread scratch: a row allocates nothing once its thread has seen the level's size.
+    struct scratch {
+        std::vector<float> bound_all; // per peak: its largest contribution to the row, or -1 behind it
+        std::vector<std::uint32_t> live;
+        std::vector<int> bucket;
+    };
+    thread_local scratch tls;
+    scratch& sc = tls; // one access of the thread-local object
+    std::vector<float>& bound_all = sc.bound_all;
+    std::vector<std::uint32_t>& live = sc.live;
+    std::vector<int>& bucket = sc.bucket;
+    const std::size_t np = pl.size();
+    bound_all.resize(np);
+    {
         // The largest cosine between the peak and a texel of the row: cos(max(0, a - half)), a
-        // the angle to the middle texel (1 inside the cone); behind the row when it is <= 0.
-        const float ca = std::clamp(mid.x * pl.px[j] + mid.y * pl.py[j] + mid.z * pl.pz[j], -1.f, 1.f);
-        const float c_max = ca >= cos_half ? 1.f : ca * cos_half + std::sqrt(std::max(0.f, 1.f - ca * ca)) * sin_half;
-        if (!(c_max > 0.f)) continue;
-        const float qb = 0.5f * (1.f - c_max) + ha2 * (1.f + c_max);
-        live.push_back(std::uint32_t(j));
-        bound.push_back(pl.lum[j] / (qb * qb));
+        // the angle to the middle texel (1 inside the cone); behind the row when it is <= 0
+        // (w(c) <= 1 for both weights). A loop without branches: it vectorises.
+        const float* px = pl.px.data();
+        const float* py = pl.py.data();
+        const float* pz = pl.pz.data();
+        const float* lum = pl.lum.data();
+        float* bd = bound_all.data();
+        for (std::size_t j = 0; j < np; ++j) {
+            const float ca = std::clamp(mid.x * px[j] + mid.y * py[j] + mid.z * pz[j], -1.f, 1.f);
+            const float c_max = ca >= cos_half ? 1.f : ca * cos_half + std::sqrt(std::max(0.f, 1.f - ca * ca)) * sin_half;
+            const float qb = 0.5f * (1.f - c_max) + ha2 * (1.f + c_max);
+            bd[j] = c_max > 0.f ? lum[j] / (qb * qb) : -1.f;
+        }
     }
+    live.clear();
+    for (std::size_t j = 0; j < np; ++j)
+        if (bound_all[j] >= 0.f) live.push_back(std::uint32_t(j));
     if (budget > 0.f && !live.empty()) {
         // Bucket b holds the bounds in [budget 2^-(b+1), budget 2^-b) (the last one everything
         // fainter; bounds >= budget are never skipped): skip buckets from the faintest while
@@ -477,13 +496,17 @@ inline void splat_peaks_row(const peak_level& pl, int face, int y, int n, vec3<f
         auto bucket_of = [&](float v) {
             if (!(v < budget)) return -1;
             if (!(v > 0.f)) return peak_cut_buckets - 1;
-            int e = 0;
-            std::frexp(v / budget, &e); // v / budget in [2^(e-1), 2^e), e <= 0
+            const float q = v / budget; // in (0, 1): q in [2^(e-1), 2^e), e <= 0
+            const std::uint32_t bits = std::bit_cast<std::uint32_t>(q);
+            int e = int((bits >> 23) & 0xffu) - 126; // normal q: frexp's exponent
+            if ((bits >> 23) == 0u) std::frexp(q, &e); // subnormal
             return std::min(-e, peak_cut_buckets - 1);
         };
-        std::vector<int> bucket(bound.size()); // -1: never skipped
-        for (std::size_t i = 0; i < bound.size(); ++i)
-            if ((bucket[i] = bucket_of(bound[i])) >= 0) sum[bucket[i]] += double(bound[i]);
+        bucket.resize(live.size()); // -1: never skipped
+        for (std::size_t i = 0; i < live.size(); ++i) {
+            const float b = bound_all[live[i]];
+            if ((bucket[i] = bucket_of(b)) >= 0) sum[bucket[i]] += double(b);
+        }
         double skipped = 0.0;
         int first_kept = peak_cut_buckets; // buckets >= first_kept are skipped
         for (int b = peak_cut_buckets - 1; b >= 0 && skipped + sum[b] <= double(budget); --b)
