@@ -86,6 +86,7 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -307,7 +308,15 @@ template <class Env> void prefilter_base_row(const Env& env, int n, const prefil
     const int face = int(row) / n, y = int(row) % n;
     if constexpr (requires { detail::pack_cube(env); }) {
         if (m.copy_level >= 0) {
-            for (int x = 0; x < n; ++x) out[x] = finite(vec3<Te>(env.texel(face, x, y, m.copy_level)));
+            // The row is contiguous in the cubemap; |a| <= max (false for NaN and infinities) is
+            // the finite test in a form that vectorises.
+            const auto* v = &env.texel(face, 0, y, m.copy_level);
+            using Ts = std::remove_cvref_t<decltype(v->x)>;
+            for (int x = 0; x < n; ++x)
+                for (int k = 0; k < 3; ++k) {
+                    const Ts a = v[x][k];
+                    out[x][k] = (a < Ts(0) ? -a : a) <= std::numeric_limits<Ts>::max() ? float(a) : 0.f;
+                }
             return;
         }
     }
@@ -478,6 +487,37 @@ public:
         ex(packed_rows(packed_), [&](std::size_t b, std::size_t e) { pack(src, b, e); });
         finish_packing(src, ex);
     }
+    /// The same, packing only the levels that a plan's levels read (first_read_level): prefilter.
+    template <class Executor>
+    prefilter_cube_source(const cubemap<T>& src, const prefilter_options& opt, const std::vector<prefilter_level>& plan,
+                          int out_size, Executor& ex)
+        : prefilter_cube_source(src, opt, ex, 0) {
+        packed_.first = first_read_level(src, plan, out_size);
+        ex(packed_rows(packed_), [&](std::size_t b, std::size_t e) { pack(src, b, e); });
+        finish_packing(src, ex);
+    }
+    /// The finest packed level that the plan's levels read: their tap tables' levels (built as
+    /// level() builds them) and the spherical-harmonic projection's level. Mirror levels read the
+    /// source itself.
+    template <class Env> [[nodiscard]] int first_read_level(const Env& env, const std::vector<prefilter_level>& plan, int out_size) const {
+        int first = int(packed_.levels.size()) - 1;
+        int bands = 0;
+        for (std::size_t k = 0; k < plan.size(); ++k) {
+            const prefilter_level& lp = plan[k];
+            if (lobe_mirror_limit<Lobe>() && lp.level == 0) continue;
+            if (const int b = prefilter_sh_bands<Lobe>(opt_, lp); b > 0) {
+                bands = std::max(bands, b);
+                continue;
+            }
+            sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(
+                env, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight,
+                prefilter_tail_roughness<Lobe>(opt_, plan, k, out_size, true));
+            table.trilinear = lp.trilinear;
+            for (const int l : make_taps(table, int(packed_.levels.size())).level) first = std::min(first, l);
+        }
+        if (bands > 0) first = std::min(first, sh_projection_level(packed_, bands));
+        return std::max(first, 0);
+    }
     /// The same with the packing left to the caller (prefilter_update spreads it over its calls):
     /// pack() every item of pack_items(), then finish_packing(), then the object is the one the
     /// other constructor builds (the same operations, so the same bits).
@@ -580,6 +620,9 @@ public:
                                                                           opt_.lod_bias, opt_.weight, next_roughness);
         table.trilinear = lp.trilinear;
         lv.taps = make_taps(table, int(packed_.levels.size()));
+        for (const int l : lv.taps.level)
+            if (l < packed_.first) // first_read_level builds the same tables: never
+                throw std::logic_error("ibl::prefilter: a tap reads an unpacked source level");
         if (next_roughness >= 0.0) lv.tail_share = float(fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).share);
         return lv;
     }
@@ -659,7 +702,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
         const std::vector<std::size_t> order = detail::prefilter_order<Lobe>(opt, plan, out.size(0), true);
         // Cubemap sources: one packed copy for every level, the peak split of the fast filter,
         // the projection of the levels by spherical harmonics.
-        detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, ex);
+        detail::prefilter_cube_source<Lobe, std::remove_cvref_t<decltype(env.texel(0, 0, 0, 0).x)>> cs(env, opt, plan, out.size(0), ex);
         cs.sh_project(detail::prefilter_sh_max_bands<Lobe>(opt, plan), ex);
         for (const std::size_t k : order) {
             const prefilter_level& lp = plan[k];

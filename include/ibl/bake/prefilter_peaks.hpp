@@ -268,7 +268,7 @@ inline bool patch_packed_peaks(packed_cube& p, const cubemap<float>& src, const 
     // peaks come in face, row, column order, so those of one coarse row are consecutive.
     std::vector<double> row_omega;
     std::vector<int> touched;
-    for (int l = 0; l < src.levels(); ++l) {
+    for (int l = std::max(p.first, 0); l < src.levels(); ++l) { // unpacked levels have nothing to patch
         const packed_cube::level& li = p.levels[std::size_t(l)];
         const int n = li.n;
         auto at = [&](int f, int x, int y) {

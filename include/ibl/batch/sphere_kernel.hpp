@@ -36,6 +36,7 @@
 #if IBL_DETAIL_CXX20
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 #include "../core/executor.hpp"
@@ -64,6 +65,9 @@ struct packed_cube {
         float nf = 1.f;      ///< float(n)
     };
     std::vector<level> levels;
+    /// Levels below this one are left unpacked (no reader: the fast filter's taps of a 256^2
+    /// source read its 64^2 mip and coarser); pack_cube_rows skips their items.
+    int first = 0;
     /// 4 floats per texel: R, G, B, 1; packed_layout leaves it to pack_cube_rows, which writes
     /// every texel of every level, borders included (core/memory.hpp).
     std::vector<float, default_init_allocator<float>> data;
@@ -103,18 +107,24 @@ inline std::size_t packed_row_level(const packed_cube& p, std::size_t item) noex
     return l;
 }
 /// Copies packing items [b, e) of c into p (packed_layout(c)): non-finite components as 0, the
-/// fourth channel 1. The items are independent: any partition gives the same copy.
+/// fourth channel 1; items of levels below p.first are skipped. The items are independent: any partition gives the same copy.
 template <class T> void pack_cube_rows(packed_cube& p, const cubemap<T>& c, std::size_t b, std::size_t e) noexcept {
     std::size_t l = 0, first = 0;
     for (std::size_t item = b; item < e; ++item) {
         while (item >= first + std::size_t(6 * p.levels[l].stride)) first += std::size_t(6 * p.levels[l++].stride);
+        if (int(l) < p.first) continue;
         const packed_cube::level& li = p.levels[l];
         const int f = int((item - first) / std::size_t(li.stride)), y = int((item - first) % std::size_t(li.stride)) - 1;
         float* q = p.data.data() + 4 * (std::size_t(li.offset) + std::size_t(f) * std::size_t(li.face_stride) +
                                         std::size_t(y + 1) * std::size_t(li.stride));
-        for (int x = -1; x <= li.n; ++x, q += 4) {
-            const vec3<T>& v = c.texel(f, x, y, int(l));
-            for (int k = 0; k < 3; ++k) q[k] = is_finite(v[k]) ? float(v[k]) : 0.f;
+        // The bordered row is contiguous in the cubemap (x = -1 .. n); a plain loop over it vectorises.
+        const vec3<T>* v = &c.texel(f, -1, y, int(l));
+        for (int x = 0; x < li.stride; ++x, q += 4) {
+            for (int k = 0; k < 3; ++k) {
+                const T a = v[x][k];
+                // |a| <= max is false for NaN and infinities: a finite test that vectorises
+                q[k] = (a < T(0) ? -a : a) <= std::numeric_limits<T>::max() ? float(a) : 0.f;
+            }
             q[3] = 1.f;
         }
     }
