@@ -496,6 +496,8 @@ public:
         ex(packed_rows(packed_), [&](std::size_t b, std::size_t e) { pack(src, b, e); });
         finish_packing(src, ex);
     }
+    /// Packs only levels >= first (first_read_level) from the next packing on (set before pack()).
+    void set_first_packed(int first) noexcept { packed_.first = first; }
     /// The finest packed level that the plan's levels read: their tap tables' levels (built as
     /// level() builds them) and the spherical-harmonic projection's level. Mirror levels read the
     /// source itself.
@@ -587,8 +589,10 @@ public:
     [[nodiscard]] std::size_t pack_items() const noexcept { return packed_rows(packed_); }
     [[nodiscard]] const std::vector<packed_cube::level>& packed_levels() const noexcept { return packed_.levels; }
     [[nodiscard]] std::size_t pack_item_texels(std::size_t item) const noexcept {
-        return std::size_t(packed_.levels[packed_row_level(packed_, item)].stride);
+        const std::size_t l = packed_row_level(packed_, item);
+        return int(l) < packed_.first ? 0 : std::size_t(packed_.levels[l].stride);
     }
+    [[nodiscard]] int first_packed() const noexcept { return packed_.first; }
     void pack(const cubemap<T>& src, std::size_t b, std::size_t e) noexcept { pack_cube_rows(packed_, src, b, e); }
     /// After every item: the peaks taken out of the packed copy (the base of the split), in place
     /// when the mips nest (patch_packed_peaks, a few texels per peak and level), else by packing

@@ -335,6 +335,7 @@ private:
         // the shape is unchanged).
         if (src_) src_->restart(*source_, ex);
         else src_.emplace(*source_, opt_, ex, 0);
+        src_->set_first_packed(0); // every level until the plan's reads are known (below)
         pack_item_ = 0;
         packed_ = false;
         sh_row_ = 0;
@@ -349,6 +350,8 @@ private:
                     set_convolved_costs(levels_[k]);
                 }
         }
+        // Only the source levels that the plan reads are packed (as prefilter does).
+        src_->set_first_packed(src_->first_read_level(*source_, plan_, first_size_));
         // The chain under construction (the rows are written into it; outside the budget).
         if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
             back_.emplace(first_size_, int(levels_.size()));
@@ -378,10 +381,13 @@ private:
     std::uint64_t setup_taps(std::size_t item) const noexcept {
         std::uint64_t t = 0;
         std::size_t first = 0;
+        int l = 0;
         for (const detail::packed_cube::level& li : src_->packed_levels()) {
             const std::size_t end = first + std::size_t(6 * li.stride);
-            if (end > item) t += std::uint64_t(end - std::max(first, item)) * ((std::uint64_t(li.stride) + pack_per_tap - 1) / pack_per_tap);
+            if (end > item && l >= src_->first_packed()) // levels below first_packed are not packed
+                t += std::uint64_t(end - std::max(first, item)) * ((std::uint64_t(li.stride) + pack_per_tap - 1) / pack_per_tap);
             first = end;
+            ++l;
         }
         return t;
     }
