@@ -6,9 +6,11 @@
 // Counters rel_l (l = 1..5): the relative RMSE of luminance at 400 texels per level against the
 // exact LD of the cube (ibl::ld_texel_sum at ibl::ld_texel_sum_level, ibl-bake's check),
 // computed once per process outside the timed loop. Two threads (thread_executor{2}).
+// BM_hdri_update_set_source: prefilter_update::set_source on the same cube (one thread).
 #include <benchmark/benchmark.h>
 
 #include <ibl/bake/prefilter.hpp>
+#include <ibl/bake/prefilter_update.hpp>
 #include <ibl/core/executor.hpp>
 #include <ibl/env/convert.hpp>
 #include <ibl/env/latlong.hpp>
@@ -101,8 +103,22 @@ void BM_hdri_fast(benchmark::State& state) {
     run(state, o, size);
 }
 
+/// args: size. prefilter_update::set_source on the courtyard with the fast default: the work a
+/// new source costs outside the update's budget (its copy of the source, the peak split and the
+/// levels' merged peaks). Counter peaks: the split's peaks.
+void BM_hdri_update_set_source(benchmark::State& state) {
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    const ibl::cubemap<float>& src = courtyard(int(state.range(0)));
+    ibl::prefilter_update<> up(src, o);
+    for (auto _ : state) up.set_source(src);
+    ibl::serial_executor one;
+    state.counters["peaks"] = double(ibl::detail::find_cube_peaks(src, o.peaks, one).peaks.size());
+}
+
 } // namespace
 
+BENCHMARK(BM_hdri_update_set_source)->ArgName("size")->Arg(256)->Arg(128)->Unit(benchmark::kMicrosecond)->UseRealTime();
 BENCHMARK(BM_hdri_fis_default)->ArgName("size")->Arg(256)->Arg(128)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_hdri_fast)
     ->ArgNames({"size", "spp", "sh"})

@@ -57,8 +57,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
-#include <map>
-#include <tuple>
+#include <utility>
 #include <vector>
 
 #include "../batch/sphere_kernel.hpp"
@@ -67,6 +66,7 @@
 #include "../core/constants.hpp"
 #include "../core/executor.hpp"
 #include "../core/math.hpp"
+#include "../core/memory.hpp"
 #include "../core/vec.hpp"
 #include "../env/cube_geometry.hpp"
 #include "../env/cubemap.hpp"
@@ -139,7 +139,7 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
     if (!opt.enabled) return s;
     const int n = src.size(0);
     const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
-    std::vector<float> lum(count);
+    std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
     ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
         for (std::size_t row = b; row < e; ++row) {
             const int f = int(row) / n, y = int(row) % n;
@@ -175,24 +175,10 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
         return f;
     };
     float above_t = least_float_above(t);
-    std::size_t above = 0;
-    for (const float l : lum) above += l >= above_t ? 1 : 0;
-    if (above > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
-        // The (max_peaks + 1)-th brightest texel is among the `above` > max_peaks texels above
-        // t: the selection runs over those only (a few thousand, not the whole level).
-        std::vector<float> sorted;
-        sorted.reserve(above);
-        for (const float l : lum)
-            if (l >= above_t) sorted.push_back(l);
-        const std::size_t k = above - 1 - std::size_t(opt.max_peaks);
-        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
-        t = std::max(t, double(sorted[k]));
-        above_t = least_float_above(t);
-    }
-    s.threshold = t;
-    if (!(t > 0.0)) return s;
-    std::vector<std::size_t> hits; // the texels above t, in cube_texel_index order (face, row, column)
-    for (std::size_t b = 0; b < count; b += 64) { // blocks with no texel above are skipped at once
+    // The texels above t, in cube_texel_index order (face, row, column); blocks with no texel above
+    // are skipped at once (the count vectorises).
+    std::vector<std::size_t> hits;
+    for (std::size_t b = 0; b < count; b += 64) {
         const std::size_t e = std::min(count, b + 64);
         int in_block = 0;
         for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
@@ -200,6 +186,20 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
             for (std::size_t i = b; i < e; ++i)
                 if (lum[i] >= above_t) hits.push_back(i);
     }
+    if (hits.size() > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
+        // The (max_peaks + 1)-th brightest texel is among these texels above t: the selection
+        // runs over those only (a few thousand, not the whole level), and the texels above the
+        // new threshold are among them, in the same order.
+        std::vector<float> sorted(hits.size());
+        for (std::size_t i = 0; i < hits.size(); ++i) sorted[i] = lum[hits[i]];
+        const std::size_t k = hits.size() - 1 - std::size_t(opt.max_peaks);
+        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+        t = std::max(t, double(sorted[k]));
+        above_t = least_float_above(t);
+        std::erase_if(hits, [&](std::size_t i) { return !(lum[i] >= above_t); });
+    }
+    s.threshold = t;
+    if (!(t > 0.0)) return s;
     const std::size_t nn = std::size_t(n) * std::size_t(n);
     for (const std::size_t i : hits) {
         const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
@@ -335,33 +335,37 @@ inline bool patch_packed_peaks(packed_cube& p, const cubemap<float>& src, const 
 /// luminance-energy centroid, in face, row, column order of the merged texels.
 inline std::vector<cube_peak> merge_cube_peaks(const std::vector<cube_peak>& peaks, int mip) {
     if (mip <= 0) return peaks;
-    std::map<std::tuple<int, int, int>, std::size_t> at;
+    // The merged texel of each peak as one key in face, row, column order; a stable sort keeps
+    // each merged texel's peaks in list order, so their sums add in that order.
+    int m = 1; // merged face size bound: keys need only be ordered, not dense
+    for (const cube_peak& p : peaks) m = std::max(m, std::max(p.x, p.y) + 1);
+    m = (m + (1 << mip) - 1) >> mip;
+    auto key_of = [&](const cube_peak& p) {
+        return (std::uint64_t(p.face) * std::uint64_t(m) + std::uint64_t(p.y >> mip)) * std::uint64_t(m) + std::uint64_t(p.x >> mip);
+    };
+    std::vector<std::pair<std::uint64_t, std::uint32_t>> order(peaks.size());
+    for (std::size_t i = 0; i < peaks.size(); ++i) order[i] = {key_of(peaks[i]), std::uint32_t(i)};
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
     std::vector<cube_peak> out;
-    std::vector<vec3<double>> centroid;
-    for (const cube_peak& p : peaks) {
-        const auto key = std::make_tuple(p.face, p.y >> mip, p.x >> mip);
-        auto it = at.find(key);
-        if (it == at.end()) {
-            it = at.emplace(key, out.size()).first;
-            cube_peak q;
-            q.face = p.face, q.x = p.x >> mip, q.y = p.y >> mip;
-            q.energy = vec3<double>(0.0);
-            out.push_back(q);
-            centroid.push_back(vec3<double>(0.0));
+    for (std::size_t i = 0; i < order.size();) {
+        const cube_peak& first = peaks[order[i].second];
+        cube_peak q;
+        q.face = first.face, q.x = first.x >> mip, q.y = first.y >> mip;
+        q.energy = vec3<double>(0.0);
+        vec3<double> centroid(0.0);
+        std::size_t j = i;
+        for (; j < order.size() && order[j].first == order[i].first; ++j) {
+            const cube_peak& p = peaks[order[j].second];
+            q.energy += p.energy;
+            q.weight += p.weight;
+            centroid += p.weight * vec3<double>(p.dir);
         }
-        cube_peak& q = out[it->second];
-        q.energy += p.energy;
-        q.weight += p.weight;
-        centroid[it->second] += p.weight * vec3<double>(p.dir);
+        const double len = length(centroid);
+        if (len > 0.0) q.dir = vec3<float>(centroid / len);
+        out.push_back(q);
+        i = j;
     }
-    std::vector<cube_peak> sorted;
-    for (const auto& [key, k] : at) {
-        cube_peak q = out[k];
-        const double len = length(centroid[k]);
-        if (len > 0.0) q.dir = vec3<float>(centroid[k] / len);
-        sorted.push_back(q);
-    }
-    return sorted;
+    return out;
 }
 
 /// The LD kernel's full width at half maximum of the GGX lobe at roughness r (radians): 2 theta

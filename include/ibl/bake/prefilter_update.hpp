@@ -335,13 +335,16 @@ private:
         // the shape is unchanged).
         if (src_) src_->restart(*source_, ex);
         else src_.emplace(*source_, opt_, ex, 0);
-        src_->set_first_packed(0); // every level until the plan's reads are known (below)
         pack_item_ = 0;
         packed_ = false;
         sh_row_ = 0;
         sh_done_ = false;
         if (!same_shape) {
+            src_->set_first_packed(0); // every level until the plan's reads are known
             plan_levels();
+            // Only the source levels that the plan reads are packed (as prefilter does); the same
+            // for every source of this shape.
+            src_->set_first_packed(src_->first_read_level(*source_, plan_, first_size_));
         } else { // the tables stay; the peaks of the fast filter's split belong to the source
             src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_)); // the projection's rows: the pass's next units
             for (std::size_t k = 0; k < levels_.size(); ++k)
@@ -350,8 +353,6 @@ private:
                     set_convolved_costs(levels_[k]);
                 }
         }
-        // Only the source levels that the plan reads are packed (as prefilter does).
-        src_->set_first_packed(src_->first_read_level(*source_, plan_, first_size_));
         // The chain under construction (the rows are written into it; outside the budget).
         if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
             back_.emplace(first_size_, int(levels_.size()));
