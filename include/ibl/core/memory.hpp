@@ -10,6 +10,9 @@
 // zero-fills were about a tenth of the fast filter's time). Every other construction (a value
 // given, a copy) is std::allocator's.
 
+#include "config.hpp" // first: a pre-C++20 build stops there with one #error
+#if IBL_DETAIL_CXX20
+
 #include <memory>
 #include <new>
 #include <type_traits>
@@ -42,3 +45,5 @@ struct for_overwrite_t {
 inline constexpr for_overwrite_t for_overwrite{};
 
 } // namespace ibl::detail
+
+#endif // IBL_DETAIL_CXX20
