@@ -7,7 +7,10 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <atomic>
 #include <random>
+#include <stdexcept>
+#include <thread>
 #include <vector>
 
 TEST_CASE_TEMPLATE("safe math: clamps, NaN handling and exact corners", T, float, double) {
@@ -133,4 +136,56 @@ TEST_CASE("executors cover [0, count) exactly once and reductions are partition-
     const float ref = ibl::parallel_reduce_blocks(ibl::serial_executor{}, 100, 0.0f, block, add);
     for (unsigned threads : {1u, 2u, 3u, 7u})
         CHECK(ibl::parallel_reduce_blocks(ibl::thread_executor{threads}, 100, 0.0f, block, add) == ref);
+}
+
+TEST_CASE("thread_executor: its persistent workers take every item once, nested and concurrent calls included") {
+    // Many calls in a row reuse the pool's workers (each call covers its range exactly once).
+    for (int call = 0; call < 200; ++call) {
+        const std::size_t count = std::size_t(1 + call % 37);
+        std::vector<int> hits(count, 0);
+        ibl::thread_executor{2}(count, [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) ++hits[i];
+        });
+        for (int h : hits) REQUIRE(h == 1);
+    }
+    // A call from inside a chunk (the pool is busy): it runs on threads of its own.
+    std::vector<std::atomic<int>> nested(64 * 16);
+    ibl::thread_executor{3}(64, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i)
+            ibl::thread_executor{3}(16, [&](std::size_t nb, std::size_t ne) {
+                for (std::size_t j = nb; j < ne; ++j) nested[i * 16 + j].fetch_add(1);
+            });
+    });
+    for (const std::atomic<int>& h : nested) CHECK(h.load() == 1);
+    // Calls from two threads at once: one gets the pool, the other its own threads.
+    std::vector<int> a(5000, 0), c(5000, 0);
+    auto fill = [](std::vector<int>& v) {
+        for (int rep = 0; rep < 20; ++rep)
+            ibl::thread_executor{2}(v.size(), [&](std::size_t b, std::size_t e) {
+                for (std::size_t i = b; i < e; ++i) ++v[i];
+            });
+    };
+    std::thread other([&] { fill(a); });
+    fill(c);
+    other.join();
+    for (std::size_t i = 0; i < a.size(); ++i) REQUIRE((a[i] == 20 && c[i] == 20));
+    // An exception in a chunk, whichever thread runs it, reaches the caller once the workers are
+    // done, and the pool serves the next call.
+    for (int rep = 0; rep < 20; ++rep)
+        CHECK_THROWS_AS(ibl::thread_executor{2}(100, [&](std::size_t b, std::size_t e) {
+                            if (b <= std::size_t(rep) && std::size_t(rep) < e) throw std::runtime_error("item rep");
+                        }),
+                        std::runtime_error);
+    // The same from inside a chunk (the nested call's own threads).
+    ibl::thread_executor{2}(2, [&](std::size_t, std::size_t) {
+        CHECK_THROWS_AS(ibl::thread_executor{2}(10, [&](std::size_t b, std::size_t) {
+                            if (b > 0) throw std::runtime_error("second range");
+                        }),
+                        std::runtime_error);
+    });
+    std::vector<int> after(100, 0);
+    ibl::thread_executor{2}(100, [&](std::size_t b, std::size_t e) {
+        for (std::size_t i = b; i < e; ++i) ++after[i];
+    });
+    for (int h : after) CHECK(h == 1);
 }
