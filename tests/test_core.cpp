@@ -12,6 +12,11 @@
 #include <stdexcept>
 #include <thread>
 #include <vector>
+#if defined(__unix__)
+#include <csignal>
+#include <sys/wait.h>
+#include <unistd.h>
+#endif
 
 TEST_CASE_TEMPLATE("safe math: clamps, NaN handling and exact corners", T, float, double) {
     const T nan = std::numeric_limits<T>::quiet_NaN();
@@ -189,3 +194,28 @@ TEST_CASE("thread_executor: its persistent workers take every item once, nested 
     });
     for (int h : after) CHECK(h == 1);
 }
+
+#if defined(__unix__)
+TEST_CASE("thread_executor: a child of fork() gets workers of its own") {
+    std::vector<int> hits(64, 0);
+    ibl::thread_executor{2}(hits.size(), [&](std::size_t b, std::size_t e) { // the parent's pool exists
+        for (std::size_t i = b; i < e; ++i) ++hits[i];
+    });
+    const pid_t pid = fork();
+    REQUIRE(pid >= 0);
+    if (pid == 0) { // the child: a call must finish (alarm: a hang ends the child with SIGALRM)
+        alarm(20);
+        std::vector<int> h(64, 0);
+        ibl::thread_executor{2}(h.size(), [&](std::size_t b, std::size_t e) {
+            for (std::size_t i = b; i < e; ++i) ++h[i];
+        });
+        int ok = 1;
+        for (int v : h) ok &= v == 1 ? 1 : 0;
+        _exit(ok ? 0 : 1);
+    }
+    int status = 0;
+    REQUIRE(waitpid(pid, &status, 0) == pid);
+    CHECK(WIFEXITED(status));
+    CHECK(WEXITSTATUS(status) == 0);
+}
+#endif

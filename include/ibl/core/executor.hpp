@@ -23,6 +23,9 @@
 #include <thread>
 #include <utility>
 #include <vector>
+#if defined(__unix__) || defined(__APPLE__)
+#include <unistd.h>
+#endif
 
 namespace ibl {
 
@@ -33,7 +36,8 @@ namespace detail {
 /// for a wake-up), and the range is taken in chunks from a shared counter, so that a thread whose
 /// items are cheap takes more of them (a face row's cost varies with where its taps and peaks
 /// read). One pool per worker count, created on first use and never destroyed (its threads wait
-/// on a condition variable until the process exits; no destruction order at exit to get wrong).
+/// on a condition variable until the process exits; no destruction order at exit to get wrong);
+/// a child of fork() starts its own.
 /// One call at a time: a call made while the pool is busy (from another thread, or from inside a
 /// job) runs on its own threads, as before the pool. An exception thrown by a chunk, on any
 /// thread, stops the call's remaining chunks and is rethrown to the caller once the workers are
@@ -52,6 +56,15 @@ public:
         static std::mutex m;
         static std::vector<worker_pool*> pools; // index: workers; leaked on purpose (header comment)
         std::lock_guard<std::mutex> lock(m);
+#if defined(__unix__) || defined(__APPLE__)
+        // A child of fork() has none of the parent's workers: it starts pools of its own (the
+        // parent's copies are left alone), where a call would otherwise wait for them forever.
+        static pid_t owner = getpid();
+        if (getpid() != owner) {
+            pools.clear();
+            owner = getpid();
+        }
+#endif
         if (pools.size() <= workers) pools.resize(workers + 1, nullptr);
         if (!pools[workers]) pools[workers] = new worker_pool(workers);
         return *pools[workers];
