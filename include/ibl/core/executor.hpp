@@ -83,11 +83,11 @@ public:
         next_.store(0, std::memory_order_relaxed);
         {
             std::lock_guard<std::mutex> lock(m_);
+            error_ = nullptr; // before the workers see the job
             active_ = threads_.size();
             ++generation_;
         }
         start_.notify_all();
-        error_ = nullptr;
         take_chunks();
         std::unique_lock<std::mutex> lock(m_);
         done_.wait(lock, [this] { return active_ == 0; }); // the workers read the job until then
