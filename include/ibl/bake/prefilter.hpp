@@ -86,7 +86,6 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <limits>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -308,15 +307,9 @@ template <class Env> void prefilter_base_row(const Env& env, int n, const prefil
     const int face = int(row) / n, y = int(row) % n;
     if constexpr (requires { detail::pack_cube(env); }) {
         if (m.copy_level >= 0) {
-            // The row is contiguous in the cubemap; |a| <= max (false for NaN and infinities) is
-            // the finite test in a form that vectorises.
+            // The row is contiguous in the cubemap: a plain loop over it vectorises.
             const auto* v = &env.texel(face, 0, y, m.copy_level);
-            using Ts = std::remove_cvref_t<decltype(v->x)>;
-            for (int x = 0; x < n; ++x)
-                for (int k = 0; k < 3; ++k) {
-                    const Ts a = v[x][k];
-                    out[x][k] = (a < Ts(0) ? -a : a) <= std::numeric_limits<Ts>::max() ? float(a) : 0.f;
-                }
+            for (int x = 0; x < n; ++x) out[x] = finite(vec3<Te>(v[x]));
             return;
         }
     }

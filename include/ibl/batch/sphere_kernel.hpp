@@ -36,7 +36,6 @@
 #if IBL_DETAIL_CXX20
 
 #include <cstddef>
-#include <limits>
 #include <vector>
 
 #include "../core/executor.hpp"
@@ -120,11 +119,7 @@ template <class T> void pack_cube_rows(packed_cube& p, const cubemap<T>& c, std:
         // The bordered row is contiguous in the cubemap (x = -1 .. n); a plain loop over it vectorises.
         const vec3<T>* v = &c.texel(f, -1, y, int(l));
         for (int x = 0; x < li.stride; ++x, q += 4) {
-            for (int k = 0; k < 3; ++k) {
-                const T a = v[x][k];
-                // |a| <= max is false for NaN and infinities: a finite test that vectorises
-                q[k] = (a < T(0) ? -a : a) <= std::numeric_limits<T>::max() ? float(a) : 0.f;
-            }
+            for (int k = 0; k < 3; ++k) q[k] = is_finite(v[x][k]) ? float(v[x][k]) : 0.f;
             q[3] = 1.f;
         }
     }
