@@ -509,6 +509,7 @@ public:
                 prefilter_tail_roughness<Lobe>(opt_, plan, k, out_size, true));
             table.trilinear = lp.trilinear;
             for (const int l : make_taps(table, int(packed_.levels.size())).level) first = std::min(first, l);
+            if (first == 0) return 0; // every level is packed: the other tables need not be built twice
         }
         if (bands > 0) first = std::min(first, sh_projection_level(packed_, bands));
         return std::max(first, 0);
