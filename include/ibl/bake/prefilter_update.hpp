@@ -221,7 +221,7 @@ public:
     /// The dearest of a pass's first units (a packed row of the source, the split's patch, a row of
     /// the projection by spherical harmonics).
     std::uint64_t setup_unit_taps() const noexcept {
-        return std::max({pack_item_taps(0), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
+        return std::max({pack_unit_taps(), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
     }
     std::uint64_t unit_taps(std::size_t k) const noexcept {
         const level_work& lw = levels_[k];
@@ -377,6 +377,13 @@ private:
     static constexpr std::size_t pack_per_tap = 1;
     std::uint64_t pack_item_taps(std::size_t item) const noexcept {
         return (std::uint64_t(src_->pack_item_texels(item)) + pack_per_tap - 1) / pack_per_tap;
+    }
+    /// The dearest packing item: a bordered row of the finest packed level (the levels below
+    /// first_packed cost nothing).
+    std::uint64_t pack_unit_taps() const noexcept {
+        const std::vector<detail::packed_cube::level>& lv = src_->packed_levels();
+        const std::size_t f = std::size_t(src_->first_packed());
+        return f < lv.size() ? (std::uint64_t(lv[f].stride) + pack_per_tap - 1) / pack_per_tap : 0;
     }
     /// The packing items from `item` on (a level's items are its bordered rows, of equal cost).
     std::uint64_t setup_taps(std::size_t item) const noexcept {
