@@ -32,8 +32,8 @@ namespace ibl {
 namespace detail {
 
 /// Persistent workers for thread_executor: a call hands its range to the workers that wait here
-/// instead of starting and joining threads (about 30-80 us a call on the 2-core VM, against a few
-/// for a wake-up), and the range is taken in chunks from a shared counter, so that a thread whose
+/// instead of starting and joining threads (a wake-up costs a small fraction of a thread's start
+/// and join: docs/ARCHITECTURE.md, "Determinism and executors"), and the range is taken in chunks from a shared counter, so that a thread whose
 /// items are cheap takes more of them (a face row's cost varies with where its taps and peaks
 /// read). One pool per worker count, created on first use and never destroyed (its threads wait
 /// on a condition variable until the process exits; no destruction order at exit to get wrong);

@@ -6,9 +6,9 @@
 // initialising (zero). A std::vector with it, resized, neither writes nor touches its new
 // elements; the first writer does. The library's bulk outputs (a prefiltered chain, its packed
 // source) are written in full by the executor's workers, so their pages are first touched by the
-// threads that fill them rather than zeroed by one thread before the work (at 256^2 the two
-// zero-fills were about a tenth of the fast filter's time). Every other construction (a value
-// given, a copy) is std::allocator's.
+// threads that fill them rather than zeroed by one thread before the work (figures:
+// docs/ARCHITECTURE.md, "The fast filter"). Every other construction (a value given, a copy) is
+// std::allocator's.
 
 #include "config.hpp" // first: a pre-C++20 build stops there with one #error
 #if IBL_DETAIL_CXX20
