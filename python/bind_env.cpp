@@ -204,7 +204,7 @@ lobe_tables tabulate_lobe(const char* fn, const py::object& model, std::vector<d
 }
 
 py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std::string& method, const std::string& weight,
-                   unsigned threads, py::object model, py::object peaks, bool coarse_tail, int sh_bands) {
+                   unsigned threads, py::object model, py::object peaks, bool coarse_tail, int sh_bands, bool mid_tail) {
     const bool py_lobe = is_python_lobe("prefilter", model);
     ibl::prefilter_options opt;
     if (method == "fis") opt.method = ibl::prefilter_method::filtered_importance;
@@ -218,6 +218,7 @@ py::list prefilter(py::object cube, int levels, std::uint32_t samples, const std
     opt.levels = levels;
     opt.samples = samples;
     opt.coarse_tail = coarse_tail;
+    opt.mid_tail.enabled = mid_tail;
     if (sh_bands < 0 || sh_bands > ibl::detail::sh_rough_band_limit)
         throw py::value_error("ibl.prefilter: sh_bands must be in [0, " + std::to_string(ibl::detail::sh_rough_band_limit) + "], got " +
                               std::to_string(sh_bands));
@@ -667,7 +668,7 @@ py::dict reference_radiance(py::object cube, py::object n, py::object v, py::obj
 void bind_env(py::module_& m) {
     m.def("prefilter", &prefilter, py::arg("cube"), py::kw_only(), py::arg("levels") = -1, py::arg("samples") = 0u,
           py::arg("method") = "fis", py::arg("weight") = "n_dot_l", py::arg("threads") = 0u, py::arg("model") = py::none(),
-          py::arg("peaks") = py::none(), py::arg("coarse_tail") = true, py::arg("sh_bands") = 24,
+          py::arg("peaks") = py::none(), py::arg("coarse_tail") = true, py::arg("sh_bands") = 24, py::arg("mid_tail") = true,
           "The prefiltered specular chain of ibl::prefilter (N = V = R): a list of float32 arrays\n"
           "(6, s, s, 3), level l of face size max(1, n >> l) for roughness l / (levels - 1).\n"
           "cube: (6, n, n, 3), faces +X, -X, +Y, -Y, +Z, -Z, [face, y, x], row 0 = t = 0. levels: -1\n"
@@ -682,7 +683,9 @@ void bind_env(py::module_& m) {
           "level's kernel tail from the finished next level (prefilter_options::coarse_tail; True by default).\n"
           "sh_bands: the fast filter's rough levels by spherical-harmonic convolution: a level whose kernel\n"
           "needs at most this many bands is reconstructed from the source's projection (prefilter_options::\n"
-          "sh_rough.max_bands; 24 by default, at most 32; 0 = tap sets on every level).");
+          "sh_rough.max_bands; 24 by default, at most 32; 0 = tap sets on every level). mid_tail: the fast\n"
+          "filter's intermediate coarse tail for the built-in lobe (prefilter_options::mid_tail; True by\n"
+          "default: a 256^2 chain's level 1 reads its tail from a half-size level at r = 0.22).");
     m.def("irradiance", &irradiance, py::arg("cube"), py::arg("size") = 32, py::kw_only(), py::arg("samples") = 1024u,
           py::arg("method") = "cosine", py::arg("threads") = 0u,
           "Irradiance cube (6, size, size, 3) float32 of ibl::irradiance_cubemap: E(n) at every texel\n"

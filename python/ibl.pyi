@@ -87,7 +87,7 @@ def prefilter(cube: ArrayLike, *, levels: int = -1, samples: int = 0, method: st
               weight: str = "n_dot_l", threads: int = 0,
               model: LobeArg = None,
               peaks: int | None = None,
-              coarse_tail: bool = True, sh_bands: int = 24) -> list[np.ndarray]: ...  # a Python model: weight "n_dot_l", peaks 0 / None
+              coarse_tail: bool = True, sh_bands: int = 24, mid_tail: bool = True) -> list[np.ndarray]: ...  # a Python model: weight "n_dot_l", peaks 0 / None
 def irradiance(cube: ArrayLike, size: int = 32, *, samples: int = 1024, method: str = "cosine",
                threads: int = 0) -> np.ndarray: ...
 def sh_project(cube: ArrayLike, bands: int = 3, *, threads: int = 0) -> np.ndarray: ...  # (bands^2, 3)

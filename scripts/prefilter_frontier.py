@@ -37,6 +37,7 @@ SETTINGS = [
     ("fast", ["--prefilter", "fast", "--quality", "high"], "fast high"),
     ("fast0", ["--prefilter", "fast", "--fast-peaks", "0"], "fast default, no peak split"),
     ("fastsh0", ["--prefilter", "fast", "--fast-sh-bands", "0"], "fast default, tap sets on every level (no SH levels)"),
+    ("fastmid0", ["--prefilter", "fast", "--fast-mid-tail", "0"], "fast default, no intermediate coarse tail"),
 ]
 
 
@@ -109,6 +110,8 @@ def main():
                         ax.plot(r["time_ms"], r["levels"][li], "x", color=colours.get(name, "k"), ms=6)
                     if r["input"] == name and r["kind"] == "fastsh0":
                         ax.plot(r["time_ms"], r["levels"][li], "+", color=colours.get(name, "k"), ms=7)
+                    if r["input"] == name and r["kind"] == "fastmid0":
+                        ax.plot(r["time_ms"], r["levels"][li], "1", color=colours.get(name, "k"), ms=8)
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_title(f"level {li + 1}")
@@ -117,7 +120,7 @@ def main():
         (axes[0] if nlev > 1 else axes).set_ylabel("rel RMSE (ibl-bake check)")
         (axes[-1] if nlev > 1 else axes).legend(fontsize=6)
         fig.suptitle("Prefilter error against time: FIS (squares) and the fast filter (circles; x = no peak split, "
-                     "+ = tap sets on every level)",
+                     "+ = tap sets on every level, Y = no intermediate coarse tail)",
                      fontsize=9)
         fig.tight_layout()
         fig.savefig(a.plot, dpi=110)

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <stdexcept>
 #include <vector>
 
 namespace {
@@ -298,4 +299,99 @@ TEST_CASE("fast coarse tail: lower error than the tap set alone on a sky over a 
     const ibl::specular_chain c = ibl::prefilter(src, on, ibl::serial_executor{});
     REQUIRE(up.result().has_value());
     check_same_bits(c, *up.result());
+}
+
+TEST_CASE("fast intermediate coarse tail: only where its face resolves its kernel; only level 1 changes; same bits in the update") {
+    // A bright sky with clouds over a textured dark ground (blocks of 1/64 of a face, at any size),
+    // filtered to the 6-level chain (r = l / 5): level 1 (r = 0.2) reads its tail from level 2.
+    auto make = [](int n) {
+        const int sc = std::max(1, n / 64);
+        ibl::cubemap<float> src(n);
+        src.fill(0, [&](int f, int x, int y) {
+            const ibl::vec3<float> d = ibl::cube_texel_direction<float>(f, x, y, n);
+            const int X = x / sc, Y = y / sc;
+            const bool stripe = ((X / 3 + Y / 2) % 3 == 0), cloud = ((X / 5 + 2 * (Y / 4)) % 4 == 0);
+            return ibl::vec3<float>(d.y > 0.f ? (cloud ? 60.f : 30.f) : (stripe ? 2.f : 0.5f));
+        });
+        src.generate_mips();
+        return src;
+    };
+    ibl::prefilter_options on = fast_options(), off = on;
+    on.levels = off.levels = 6;
+    off.mid_tail.enabled = false;
+    // The rule: the intermediate level (the next level's face) must span the full width at half
+    // maximum of its kernel (r = 0.22) with min_texels (3) texels: a 256^2 chain's 64^2 does
+    // (FWHM 0.125 rad, 4 texels of 2 / 64 rad), a 64^2 chain's 16^2 does not.
+    const ibl::cubemap<float> small = make(64);
+    const std::vector<ibl::prefilter_level> plan = ibl::prefilter_plan(on, 64);
+    CHECK(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(on, plan, 1, 64, true) < 0.0);
+    CHECK(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(on, ibl::prefilter_plan(on, 256), 1, 256, true) ==
+          doctest::Approx(0.22));
+    CHECK(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(on, ibl::prefilter_plan(on, 256), 2, 256, true) < 0.0); // r = 0.4 > max_roughness
+    CHECK(ibl::detail::prefilter_mid_roughness<ibl::charlie_lobe>(on, ibl::prefilter_plan(on, 256), 1, 256, true) < 0.0);
+    check_same_bits(ibl::prefilter(small, on, ibl::thread_executor{2}), ibl::prefilter(small, off, ibl::thread_executor{2}));
+    // Forced at 64^2 (min_texels lowered): only level 1 changes, and the update gives the same bits.
+    ibl::prefilter_options forced = on;
+    forced.mid_tail.min_texels = 0.5;
+    const ibl::specular_chain a = ibl::prefilter(small, forced, ibl::thread_executor{2});
+    const ibl::specular_chain b = ibl::prefilter(small, off, ibl::thread_executor{2});
+    int differ = 0;
+    for (int l = 0; l < a.levels(); ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < a.size(l); ++y)
+                for (int x = 0; x < a.size(l); ++x) {
+                    const ibl::vec3<float> p = a.texel(f, x, y, l), q = b.texel(f, x, y, l);
+                    const bool same = std::memcmp(&p, &q, sizeof p) == 0;
+                    if (l != 1) CHECK(same);
+                    differ += same ? 0 : 1;
+                }
+    CHECK(differ > 6 * 32 * 32 / 2);
+    for (const std::uint64_t budget : {97u, 3001u}) {
+        ibl::prefilter_update<> up(small, forced);
+        CHECK(up.unit_taps(1) >= 16);
+        while (!up.done()) up.step(budget, ibl::serial_executor{});
+        REQUIRE(up.result().has_value());
+        check_same_bits(a, *up.result());
+    }
+    // The work check counts the intermediate level (its samples clamped to limits::max_samples).
+    ibl::prefilter_options huge = forced;
+    huge.mid_tail.mid = 1e12;
+    CHECK_THROWS_AS(ibl::prefilter(small, huge, ibl::serial_executor{}), std::length_error);
+    CHECK_THROWS_AS(ibl::prefilter_update<>(small, huge), std::length_error);
+    // A 256^2 chain: level 1 against the exact LD (ld_texel_sum over level 1 of the source, the
+    // tool's check), with 40 taps a texel (24 + 64 / 4) against the next level's tail at 64.
+    const ibl::cubemap<float> big = make(256);
+    const ibl::specular_chain c = ibl::prefilter(big, on, ibl::thread_executor{2});
+    const ibl::specular_chain d = ibl::prefilter(big, off, ibl::thread_executor{2});
+    std::vector<std::array<int, 3>> at;
+    std::vector<ibl::vec3<double>> dirs;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 5; y < 128; y += 25)
+            for (int x = 7; x < 128; x += 25) {
+                at.push_back({f, x, y});
+                dirs.push_back(ibl::cube_texel_direction<double>(f, x, y, 128));
+            }
+    const std::vector<ibl::vec3<double>> refs =
+        ibl::ld_texel_sum(big, ibl::ld_texel_sum_level(big, 0.2), dirs, 0.2, ibl::ld_weight::n_dot_l, ibl::thread_executor{2});
+    auto err = [&](const ibl::specular_chain& ch) {
+        double s = 0.0;
+        for (std::size_t i = 0; i < at.size(); ++i) {
+            const auto [f, x, y] = at[i];
+            const double g = ch.texel(f, x, y, 1).y, ref = refs[i].y;
+            s += (g - ref) * (g - ref) / (ref * ref);
+        }
+        return std::sqrt(s / double(at.size()));
+    };
+    // A white furnace stays white: the intermediate level's share and the rest's add to 1.
+    ibl::cubemap<float> white(256);
+    white.fill(0, [](int, int, int) { return ibl::vec3<float>(1.f); });
+    white.generate_mips();
+    const ibl::specular_chain w = ibl::prefilter(white, on, ibl::thread_executor{2});
+    for (int l = 0; l < w.levels(); ++l)
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < w.size(l); y += 7)
+                for (int x = 0; x < w.size(l); x += 7) CHECK(w.texel(f, x, y, l).y == doctest::Approx(1.0).epsilon(1e-5));
+    const double ec = err(c), ed = err(d);
+    MESSAGE("256^2 level 1 against the exact LD: intermediate tail " << ec << " (40 taps a texel), next level's tail " << ed << " (64)");
+    CHECK(ec < 1.1 * ed);
 }

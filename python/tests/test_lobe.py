@@ -193,6 +193,23 @@ def test_fast_filter_coarse_tail():
     assert all(np.array_equal(a, b) for a, b in zip(fis_on, fis_off))
 
 
+def test_fast_filter_mid_tail():
+    # a 256^2 cube (6 levels): level 1 (r = 0.2) reads its kernel tail from an intermediate level
+    # at r = 0.22 (64^2); mid_tail=False reads level 2; no other level changes
+    n = 256
+    rng = np.random.default_rng(3)
+    cube = (1.0 + 4.0 * rng.random((6, n, n, 3))).astype(np.float32)
+    cube[2] *= 10.0
+    on = ibl.prefilter(cube, method="fast", threads=1)
+    off = ibl.prefilter(cube, method="fast", threads=1, mid_tail=False)
+    assert len(on) == 6
+    assert not np.array_equal(on[1], off[1])
+    for k in (0, 2, 3, 4, 5):
+        assert np.array_equal(on[k], off[k])
+    white = ibl.prefilter(np.ones((6, n, n, 3), np.float32), method="fast", threads=1)
+    assert all(np.allclose(level, 1.0, rtol=0, atol=1e-5) for level in white)
+
+
 def test_fast_filter_sh_levels():
     # a 64^2 cube (5 levels, r = l / 4): levels 2-4 are reconstructed from spherical harmonics by
     # default; sh_bands=0 filters them by their tap sets; level 1 (r = 0.25) keeps its tap set

@@ -897,6 +897,7 @@ void print_prefilter_fixtures() {
     o.method = ibl::prefilter_method::fast;
     o.peaks.enabled = true;
     o.peaks.cut = 0.0; // every peak in front of some texel of a row: the GLSL's plain sum over the list
+    o.mid_tail.enabled = false; // the GLSL filter reads every coarse tail from the next level (no intermediate level)
     // What prefilter's cubemap source holds (detail::prefilter_cube_source): the split's base packed
     // when there are peaks, else the source.
     const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(src, o.peaks, ibl::serial_executor{});

@@ -170,6 +170,23 @@ struct prefilter_options {
     /// bilinear read per texel; the levels are filtered coarse to fine) and spends its tap set on
     /// the rest. Read by method = fast only; false filters every level from the source alone.
     bool coarse_tail = true;
+    /// The fast filter's intermediate coarse tail (bake/prefilter_fast.hpp, "Intermediate coarse
+    /// tail"; cubemap sources, the GGX lobe): a level with a coarse tail, at roughness up to
+    /// max_roughness, reads it from an intermediate level at r + position (r_next - r) with the
+    /// next level's face, filtered with `mid` times the level's samples and its own coarse tail
+    /// from the next level, and spends `own` times its samples on the narrower rest of its kernel
+    /// (the defaults: 24 + 64 / 4 = 40 taps a texel instead of 64). Only where that face resolves
+    /// the intermediate kernel: its full width at half maximum spans at least min_texels texels
+    /// (a 256^2 chain's level 1, not a 128^2 one's). The intermediate level is not part of the
+    /// output. enabled = false reads the next level directly.
+    struct mid_tail_options {
+        bool enabled = true;
+        double max_roughness = 0.3;
+        double position = 0.1;
+        double own = 0.375;
+        double mid = 1.0;
+        double min_texels = 3.0;
+    } mid_tail{};
     /// The fast filter's rough levels by spherical-harmonic convolution (bake/prefilter_sh.hpp):
     /// read by method = fast on a cubemap source; a level whose kernel needs at most
     /// sh_rough.max_bands bands is reconstructed from the source's projection instead of its tap
@@ -436,6 +453,51 @@ template <class Lobe> double prefilter_tail_roughness(const prefilter_options& o
     if (k + 1 >= 31 || (first_size >> (k + 1)) < prefilter_coarse_tail_min_face) return -1.0;
     return std::clamp(std::isfinite(plan[k + 1].roughness) ? plan[k + 1].roughness : 0.0, 0.0, 1.0);
 }
+/// The roughness of the intermediate level that plan level k reads its coarse tail from
+/// (prefilter_options::mid_tail; cubemap sources), or -1 when it reads the next level directly or
+/// has no coarse tail.
+template <class Lobe> double prefilter_mid_roughness(const prefilter_options& opt, const std::vector<prefilter_level>& plan,
+                                                     std::size_t k, int first_size, bool cube_source) {
+    if constexpr (!std::is_same_v<Lobe, ggx_lobe>) return -1.0;
+    const prefilter_options::mid_tail_options& m = opt.mid_tail;
+    if (!cube_source || !m.enabled || !(m.position > 0.0) || !(m.position < 1.0) || !(m.own > 0.0) || !(m.mid > 0.0)) return -1.0;
+    const double rn = prefilter_tail_roughness<Lobe>(opt, plan, k, first_size, true);
+    if (rn < 0.0) return -1.0;
+    const double r = std::clamp(std::isfinite(plan[k].roughness) ? plan[k].roughness : 0.0, 0.0, 1.0);
+    if (!(r <= m.max_roughness) || !(rn > r)) return -1.0;
+    const double rm = r + m.position * (rn - r);
+    // the intermediate level's face (the next level's) resolves its kernel: a texel at the face
+    // centre is 2 / face radians
+    const int face = std::max(1, first_size >> int(k + 1));
+    if (!(ggx_ld_fwhm(rm) >= (std::isfinite(m.min_texels) ? m.min_texels : 3.0) * 2.0 / double(face))) return -1.0;
+    return rm;
+}
+/// The samples of a level that reads an intermediate level: its own tap set's (own times s, at
+/// least 1) and the intermediate level's (mid times s, at least 1, at most limits::max_samples).
+inline std::uint32_t prefilter_mid_own_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
+    return std::uint32_t(std::clamp(std::lround(std::min(opt.mid_tail.own, 1.0) * double(std::max<std::uint32_t>(s, 1))), 1L,
+                                    long(std::max<std::uint32_t>(s, 1))));
+}
+inline std::uint32_t prefilter_mid_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
+    const double v = std::min(opt.mid_tail.mid * double(std::max<std::uint32_t>(s, 1)), double(limits::max_samples));
+    return std::uint32_t(std::max(1.0, std::round(v)));
+}
+/// prefilter's work check with the intermediate levels (mid_tail) of a cubemap source: the plan's
+/// taps (check_prefilter_work) plus 6 n_m^2 samples_m of each intermediate level.
+template <class Lobe> void check_prefilter_mid_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int first_size) {
+    std::uint64_t work = 0;
+    for (std::size_t k = 0; k < plan.size(); ++k) {
+        const prefilter_level& lp = plan[k];
+        if (lp.level < 1 && lobe_mirror_limit<Lobe>()) continue;
+        const std::uint64_t n = std::uint64_t(std::max(1, first_size >> int(k)));
+        work = work_add(work, 6 * n * n, std::uint64_t(lp.samples) * (lp.trilinear ? 2u : 1u));
+        if (prefilter_mid_roughness<Lobe>(opt, plan, k, first_size, true) >= 0.0) {
+            const std::uint64_t m = std::max<std::uint64_t>(1, n / 2);
+            work = work_add(work, 6 * m * m, std::uint64_t(prefilter_mid_samples(opt, lp.samples)) * (lp.trilinear ? 2u : 1u));
+        }
+    }
+    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l, intermediate levels included)", work, limits::max_work, "limits::max_work");
+}
 /// The order prefilter computes the plan's levels in: coarse to fine when a level reads its
 /// coarse tail, else fine to coarse.
 template <class Lobe>
@@ -504,12 +566,24 @@ public:
                 bands = std::max(bands, b);
                 continue;
             }
-            sphere_sample_table<float> table = make_ld_table_for<float, Lobe>(
-                env, lp.roughness, lp.samples, opt_.method, opt_.lod_bias, opt_.weight,
-                prefilter_tail_roughness<Lobe>(opt_, plan, k, out_size, true));
-            table.trilinear = lp.trilinear;
-            for (const int l : make_taps(table, int(packed_.levels.size())).level) first = std::min(first, l);
-            if (first == 0) return 0; // every level is packed: the other tables need not be built twice
+            const double rn = prefilter_tail_roughness<Lobe>(opt_, plan, k, out_size, true);
+            const double rm = prefilter_mid_roughness<Lobe>(opt_, plan, k, out_size, true);
+            // the level's table, and its intermediate level's (mid_tail), as level() builds them
+            for (int part = 0; part < (rm >= 0.0 ? 2 : 1); ++part) {
+                prefilter_level t = lp;
+                double next = rn;
+                if (rm >= 0.0 && part == 0) t.samples = prefilter_mid_own_samples(opt_, lp.samples), next = rm;
+                if (part == 1) t.roughness = rm, t.samples = prefilter_mid_samples(opt_, lp.samples);
+                if (part == 1 && prefilter_sh_bands<Lobe>(opt_, t) > 0) {
+                    bands = std::max(bands, prefilter_sh_bands<Lobe>(opt_, t));
+                    continue;
+                }
+                sphere_sample_table<float> table =
+                    make_ld_table_for<float, Lobe>(env, t.roughness, t.samples, opt_.method, opt_.lod_bias, opt_.weight, next);
+                table.trilinear = t.trilinear;
+                for (const int l : make_taps(table, int(packed_.levels.size())).level) first = std::min(first, l);
+                if (first == 0) return 0; // every level is packed: the other tables need not be built twice
+            }
         }
         if (bands > 0) first = std::min(first, sh_projection_level(packed_, bands));
         return std::max(first, 0);
@@ -624,6 +698,25 @@ public:
         if (next_roughness >= 0.0) lv.tail_share = float(fast_tail_of<Lobe>(clamped(lp.roughness), next_roughness, opt_.weight).share);
         return lv;
     }
+    /// The intermediate level of plan level lp (prefilter_mid_roughness rm; its coarse tail from
+    /// the level of roughness rn): its taps (prefilter_mid_samples), no peaks (the level that reads
+    /// it adds them through its own kernel). Its face nm is the next level's (half of lp's).
+    template <class Env, class Executor>
+    prefilter_cube_level mid_level(const Env& env, const prefilter_level& lp, double rm, double rn, int nm, Executor& ex) const {
+        prefilter_level m = lp;
+        m.level = lp.level + 1;
+        m.roughness = rm;
+        m.samples = prefilter_mid_samples(opt_, lp.samples);
+        prefilter_cube_level lv = level(env, m, rn, nm, ex);
+        lv.peaks = {};
+        return lv;
+    }
+    /// Plan level lp with the samples of its own tap set when it reads an intermediate level.
+    [[nodiscard]] prefilter_level mid_owner(const prefilter_level& lp) const {
+        prefilter_level o = lp;
+        o.samples = prefilter_mid_own_samples(opt_, lp.samples);
+        return o;
+    }
     /// The merged peaks of a plan level (empty without a split), with the level's whole kernel.
     [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
         if (peaks_.empty()) return {};
@@ -692,6 +785,8 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
     detail::check_prefilter_work(opt, plan, base);
+    if constexpr (requires { detail::pack_cube(env); })
+        detail::check_prefilter_mid_work<Lobe>(opt, plan, std::max(1, base >> plan.front().level));
     // Every interior texel of every level is written below (by the workers, in place), then the borders.
     cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()), detail::for_overwrite);
     // Coarse to fine when a level reads its coarse tail from the next (finished) level.
@@ -715,8 +810,21 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 });
             } else {
                 const double rn = detail::prefilter_tail_roughness<Lobe>(opt, plan, k, out.size(0), true);
-                const detail::prefilter_cube_level lv = cs.level(env, lp, rn, n, ex);
+                const double rm = detail::prefilter_mid_roughness<Lobe>(opt, plan, k, out.size(0), true);
                 const cubemap<float>* nx = rn >= 0.0 && next ? &*next : nullptr;
+                std::optional<cubemap<float>> mid; // the intermediate level (mid_tail), which this level's tail reads
+                if (rm >= 0.0) {
+                    const int nm = std::max(1, n / 2);
+                    const detail::prefilter_cube_level lm = cs.mid_level(env, lp, rm, rn, nm, ex);
+                    mid.emplace(nm, 1, detail::for_overwrite);
+                    ex(std::size_t(6 * nm), [&](std::size_t b, std::size_t e) {
+                        for (std::size_t row = b; row < e; ++row)
+                            cs.row(lm, row, nm, &mid->texel_ref(int(row) / nm, 0, int(row) % nm, 0), nx, nullptr);
+                    });
+                    mid->update_borders();
+                    nx = &*mid;
+                }
+                const detail::prefilter_cube_level lv = cs.level(env, rm >= 0.0 ? cs.mid_owner(lp) : lp, rm >= 0.0 ? rm : rn, n, ex);
                 // The level before this one reads its coarse tail from this level without its peaks
                 // (they are added to every level exactly, through its own kernel).
                 std::vector<vec3<float>> base;

@@ -54,6 +54,23 @@
 // docs/ibl-bake.md "Fast filter"): on two HDRIs it lowers levels 1-3 of a 256^2 chain by 1.1-2x at
 // the same samples.
 //
+// Intermediate coarse tail (prefilter_options::mid_tail, on by default; cubemap sources, GGX).
+// The next level's kernel lies under a sharp level's for little of its mass (c Z_next / Z = 5.8 %
+// at r = 0.2 under r = 0.4), so the rest kernel keeps most of the tail. The split above holds for
+// any wider kernel: a level at r <= mid_tail.max_roughness reads its tail from an intermediate
+// level at r_m = r + position (r_next - r) (0.22 for 0.2 and 0.4), with c and the rest kernel of
+// K and K_m (a larger share of K), and the intermediate level is filtered like any level (its tap
+// set of mid times the level's samples, its own coarse tail from the next level, no peaks: the
+// level that reads it adds them through its own kernel) on the next level's face, a quarter of
+// the level's texels. The level's own tap set covers the narrower rest with own times its samples
+// (24 + 64 / 4 = 40 taps a texel for the default 64). The intermediate level is read bilinearly
+// at the level's texel centres, which needs its face to resolve K_m: only where the full width at
+// half maximum of K_m (ggx_ld_fwhm) spans at least min_texels (3) texels of the face centre
+// (2 / face radians): a 256^2 chain's level 1 (64^2, 4 texels), not a 128^2 one's (2 texels,
+// where it raised level 1's error on two of three sources; docs/ibl-bake.md "Fast filter", and
+// research/fast_mid_tail_study). It is not part of the output; prefilter_update computes it as
+// work units just before the level that reads it, so the two still give the same bits.
+//
 // Cost: N samples per texel (one bilinear tap each from the nearest level, the default plan's
 // reads; two with trilinear reads). The default schedule is fast_default_samples * 4^(l - 1), at
 // most prefilter_max_scheduled_samples (equal_cost_prefilter_samples: every level costs the taps of

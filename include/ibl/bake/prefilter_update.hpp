@@ -45,7 +45,10 @@
 // Storage. The rows are written in place into the chain under construction, and a level that a
 // coarse tail reads is written before its peaks into a cube of its own (as_next), row by row, so
 // nothing is copied when a level or a pass finishes: the faces' borders are work units, and the
-// finished chain is swapped with the previous result.
+// finished chain is swapped with the previous result. An intermediate level of the fast filter
+// (prefilter_options::mid_tail, bake/prefilter_fast.hpp) is a level of units like the others,
+// just before the level that reads it, written only into its own cube (it has no peaks and no
+// place in the chain); unit_taps of the level that reads it counts its units too.
 //
 // A pass starts with more units: the packed copy of the source that the taps read, a bordered row
 // of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
@@ -223,9 +226,11 @@ public:
     std::uint64_t setup_unit_taps() const noexcept {
         return std::max({pack_unit_taps(), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
     }
+    /// (A level that reads an intermediate level, prefilter_options::mid_tail, counts that
+    /// level's units too.)
     std::uint64_t unit_taps(std::size_t k) const noexcept {
-        const level_work& lw = levels_[k];
-        return std::max(lw.border_taps, lw.whole_rows() ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
+        const std::uint64_t own = work_unit_taps(levels_[k]);
+        return levels_[k].mid >= 0 ? std::max(own, work_unit_taps(levels_[std::size_t(levels_[k].mid)])) : own;
     }
 
 private:
@@ -271,8 +276,8 @@ private:
             const std::size_t rows_total = std::size_t(6 * lw.n);
             if (row_ == rows_total) { // the finished level's borders, a face per unit
                 if ((spent > 0 || !progress) && lw.border_taps > budget - spent) break;
-                back_->update_borders(int(level_), int(face_));
-                if (levels_[level_].as_next) levels_[level_].as_next->update_borders(0, int(face_));
+                if (lw.chain >= 0) back_->update_borders(lw.chain, int(face_));
+                if (lw.as_next) levels_[level_].as_next->update_borders(0, int(face_));
                 spent += lw.border_taps;
                 if (++face_ == 6) next_level();
                 continue;
@@ -347,15 +352,15 @@ private:
             src_->set_first_packed(src_->first_read_level(*source_, plan_, first_size_));
         } else { // the tables stay; the peaks of the fast filter's split belong to the source
             src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_)); // the projection's rows: the pass's next units
-            for (std::size_t k = 0; k < levels_.size(); ++k)
+            for (std::size_t k = 0; k < plan_.size(); ++k) // an intermediate level has no peaks
                 if (!levels_[k].mirror) {
                     levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
                     set_convolved_costs(levels_[k]);
                 }
         }
         // The chain under construction (the rows are written into it; outside the budget).
-        if (!back_ || back_->levels() != int(levels_.size()) || back_->size(0) != first_size_)
-            back_.emplace(first_size_, int(levels_.size()));
+        if (!back_ || back_->levels() != int(plan_.size()) || back_->size(0) != first_size_)
+            back_.emplace(first_size_, int(plan_.size()));
         pos_ = 0;
         level_ = order_.front();
         row_ = 0;
@@ -424,6 +429,9 @@ private:
     }
     struct level_work {
         int n = 1;
+        int chain = -1;                      ///< the output level it fills, or -1: an intermediate level (mid_tail), kept in as_next
+        int tail_from = -1;                  ///< the level (index into levels_) whose as_next its coarse tail reads, or -1
+        int mid = -1;                        ///< the intermediate level it reads its tail from (index into levels_), or -1
         bool mirror = false;                 ///< level 0 of a mirror lobe: a copy / one read per texel
         detail::prefilter_base_read base{};  ///< the mirror level's read
         detail::prefilter_cube_level conv{}; ///< a convolved level's taps and peaks
@@ -437,6 +445,10 @@ private:
         /// A mirror level or a level by spherical harmonics: whole rows are the units.
         bool whole_rows() const noexcept { return mirror || conv.sh.active(); }
     };
+    /// The dearest work unit of a level: a face's borders, a whole row, or a chunk's tap with the row's finish.
+    static std::uint64_t work_unit_taps(const level_work& lw) noexcept {
+        return std::max(lw.border_taps, lw.whole_rows() ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
+    }
     /// The taps of a whole level: its rows and its faces' borders.
     static std::uint64_t level_taps(const level_work& lw) noexcept {
         return std::uint64_t(6 * lw.n) * lw.taps_per_row + 6 * lw.border_taps;
@@ -464,28 +476,56 @@ private:
         first_size_ = std::max(1, base >> plan_.front().level);
         // The projection of the levels by spherical harmonics (its rows: the pass's units after the packing).
         src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_));
+        detail::check_prefilter_mid_work<Lobe>(opt_, plan_, first_size_);
         levels_.clear();
+        // The output levels at their plan index, then the intermediate levels (mid_tail), each
+        // computed just before the level that reads it, as prefilter does.
+        std::vector<level_work> mids;
         for (std::size_t k = 0; k < plan_.size(); ++k) {
             const prefilter_level& lp = plan_[k];
             level_work lw;
             lw.n = std::max(1, first_size_ >> int(k));
+            lw.chain = int(k);
             lw.mirror = lobe_mirror_limit<Lobe>() && lp.level == 0;
             if (lw.mirror) {
                 lw.base = detail::prefilter_base_mode(*source_, lw.n, lp.trilinear);
                 lw.taps_per_row = std::uint64_t(lw.n);
             } else {
                 lw.tail_roughness = detail::prefilter_tail_roughness<Lobe>(opt_, plan_, k, first_size_, true);
+                const double rm = detail::prefilter_mid_roughness<Lobe>(opt_, plan_, k, first_size_, true);
                 serial_executor one;
-                lw.conv = src_->level(*source_, lp, lw.tail_roughness, lw.n, one);
+                if (rm >= 0.0) {
+                    level_work m;
+                    m.n = std::max(1, lw.n / 2);
+                    m.tail_roughness = lw.tail_roughness;
+                    m.tail_from = int(k) + 1;
+                    m.conv = src_->mid_level(*source_, lp, rm, lw.tail_roughness, m.n, one);
+                    set_convolved_costs(m);
+                    lw.conv = src_->level(*source_, src_->mid_owner(lp), rm, lw.n, one);
+                    lw.tail_roughness = rm;
+                    lw.mid = lw.tail_from = int(plan_.size() + mids.size());
+                    mids.push_back(std::move(m));
+                } else {
+                    lw.conv = src_->level(*source_, lp, lw.tail_roughness, lw.n, one);
+                    if (lw.tail_roughness >= 0.0) lw.tail_from = int(k) + 1;
+                }
                 set_convolved_costs(lw);
             }
             levels_.push_back(std::move(lw));
         }
-        for (std::size_t k = 1; k < levels_.size(); ++k)
-            if (levels_[k - 1].tail_roughness >= 0.0) levels_[k].as_next.emplace(levels_[k].n, 1);
-        for (level_work& lw : levels_) // a face's edges (4 n) and corners, in each cube that keeps the level
-            lw.border_taps = (std::uint64_t(4 * lw.n + 4) * (lw.as_next ? 2u : 1u) + border_per_tap - 1) / border_per_tap;
-        order_ = detail::prefilter_order<Lobe>(opt_, plan_, first_size_, true);
+        for (level_work& m : mids) levels_.push_back(std::move(m));
+        // A level that a coarse tail reads keeps a copy before its peaks (an intermediate level: itself).
+        for (std::size_t k = 0; k < levels_.size(); ++k)
+            if (const int t = levels_[k].tail_from; t >= 0) levels_[std::size_t(t)].as_next.emplace(levels_[std::size_t(t)].n, 1);
+        for (level_work& lw : levels_) { // a face's edges (4 n) and corners, in each cube that keeps the level
+            const std::uint64_t cubes = (lw.chain >= 0 ? 1u : 0u) + (lw.as_next ? 1u : 0u);
+            lw.border_taps = (std::uint64_t(4 * lw.n + 4) * cubes + border_per_tap - 1) / border_per_tap;
+        }
+        order_.clear();
+        for (const std::size_t k : detail::prefilter_order<Lobe>(opt_, plan_, first_size_, true)) {
+            if (levels_[k].mid >= 0) order_.push_back(std::size_t(levels_[k].mid));
+            order_.push_back(k);
+        }
     }
 
     /// Whole rows [begin, end) of the current level, through the executor.
@@ -510,19 +550,23 @@ private:
         });
     }
 
+    /// Row r of the current level: in the chain under construction, or in as_next for an
+    /// intermediate level.
     vec3<float>* row_out(std::size_t r) {
-        const int n = levels_[level_].n;
-        return &back_->texel_ref(int(r) / n, 0, int(r) % n, int(level_));
+        level_work& lw = levels_[level_];
+        const int n = lw.n;
+        if (lw.chain < 0) return &lw.as_next->texel_ref(int(r) / n, 0, int(r) % n, 0);
+        return &back_->texel_ref(int(r) / n, 0, int(r) % n, lw.chain);
     }
-    /// Row r of the current level before its peaks, in as_next (null when no level reads it).
+    /// Row r of the current level before its peaks, in as_next (null when no level reads it, and
+    /// for an intermediate level, which has no peaks).
     vec3<float>* row_before_peaks(std::size_t r) {
         level_work& lw = levels_[level_];
-        return lw.as_next ? &lw.as_next->texel_ref(int(r) / lw.n, 0, int(r) % lw.n, 0) : nullptr;
+        return lw.as_next && lw.chain >= 0 ? &lw.as_next->texel_ref(int(r) / lw.n, 0, int(r) % lw.n, 0) : nullptr;
     }
     const cubemap<float>* next_level_cube() const {
         const level_work& lw = levels_[level_];
-        return lw.tail_roughness >= 0.0 && level_ + 1 < levels_.size() && levels_[level_ + 1].as_next ? &*levels_[level_ + 1].as_next
-                                                                                                     : nullptr;
+        return lw.tail_from >= 0 && levels_[std::size_t(lw.tail_from)].as_next ? &*levels_[std::size_t(lw.tail_from)].as_next : nullptr;
     }
     template <std::size_t W> detail::lane_sums<W>& sums() noexcept {
         if constexpr (W == 16) return sums16_;

@@ -211,6 +211,7 @@ option_map convention_options() {
         {"--fast-sh-bands", {true, [](bake_options& o, const std::string& v) {
              o.fast_sh_bands = int(parse_integer("--fast-sh-bands", v, 0, ibl::detail::sh_rough_band_limit));
          }}},
+        {"--fast-mid-tail", {true, [](bake_options& o, const std::string& v) { o.fast_mid_tail = parse_integer("--fast-mid-tail", v, 0, 1) != 0; }}},
         {"--ld-weight", {true, [](bake_options& o, const std::string& v) { o.ld_weight = choice("--ld-weight", v, {ibl::ld_weight::g1, ibl::ld_weight::n_dot_l}); }}},
         {"--runtime", {true, [](bake_options& o, const std::string& v) { o.runtime = choice("--runtime", v, {runtime_choice::lobe, runtime_choice::taps2, runtime_choice::split_sum}); }}},
     };
@@ -279,12 +280,12 @@ const option_map& option_table() {
 /// The options a probe-set bake (--probes) uses besides --probes and --out: each capture is read
 /// like --input (--input-layout, --max-input-pixels, --part), baked into the full bake's chain
 /// (--size, --levels, --quality, --threads, --policy, --ld-weight, --prefilter, --fast-peaks,
-/// --fast-sh-bands, --mirror) and SH3,
+/// --fast-sh-bands, --fast-mid-tail, --mirror) and SH3,
 /// and stored in one KTX2 array (--ktx2-format, --ktx2-quality, --ktx2-zstd); --quiet.
 bool applies_to_probes(const std::string& name) {
     static const char* const used[] = {"--probes", "--out", "--input-layout", "--max-input-pixels", "--part", "--size",
                                        "--levels", "--quality", "--threads", "--policy", "--ld-weight", "--prefilter",
-                                       "--fast-peaks", "--fast-sh-bands", "--mirror", "--ktx2-format", "--ktx2-quality", "--ktx2-zstd", "--quiet",
+                                       "--fast-peaks", "--fast-sh-bands", "--fast-mid-tail", "--mirror", "--ktx2-format", "--ktx2-quality", "--ktx2-zstd", "--quiet",
                                        "--help", "-h", "--version"};
     for (const char* u : used)
         if (name == u) return true;
@@ -306,7 +307,7 @@ void check_combination(const bake_options& o, bool have_out, const std::vector<s
             if (!applies_to_probes(name))
                 throw usage_error(name + " does not apply to --probes (a probe set bakes each capture's specular chain and "
                                          "SH3 only; it takes --size, --levels, --quality, --threads, --policy, --ld-weight, "
-                                         "--prefilter, --fast-peaks, --fast-sh-bands, --mirror, --input-layout, --max-input-pixels, --part, --ktx2-format, "
+                                         "--prefilter, --fast-peaks, --fast-sh-bands, --fast-mid-tail, --mirror, --input-layout, --max-input-pixels, --part, --ktx2-format, "
                                          "--ktx2-quality, --ktx2-zstd, --quiet)");
     if (o.compare_full && o.scene.empty()) throw usage_error("--compare-full needs --scene");
     if (o.strict && o.scene.empty()) throw usage_error("--strict needs --scene");
@@ -394,6 +395,9 @@ std::string usage_text() {
            "                     0 = off) taken out of the tap set and added back exactly\n"
            "  --fast-sh-bands N  the fast filter's rough levels by spherical-harmonic convolution: a level\n"
            "                     whose kernel needs at most N bands (default 24, at most 32; 0 = off)\n"
+           "  --fast-mid-tail B  the fast filter's intermediate coarse tail (default 1; 0 = off): a level at\n"
+           "                     r <= 0.3 reads its kernel's tail from a half-size level between it and the\n"
+           "                     next, where that face resolves the kernel (a 256^2 chain's level 1)\n"
            "  --ld-weight W      nl (default: Karis D n.l) | g1 (D G1, the true lobe at n.v = 1)\n"
            "  --runtime M        split-sum (default: LD(R, r) DFG) | lobe (lobe LUT) | taps2 (two fitted taps)\n"
            "  --lookup DIR       answer queries on stdin from the bake in DIR: specular X Y Z R, dfg NV R,\n"

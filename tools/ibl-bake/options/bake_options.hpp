@@ -162,6 +162,7 @@ struct bake_options {
     prefilter_choice prefilter = prefilter_choice::fis; ///< --prefilter: the chain's filter
     std::uint32_t fast_peaks = 1024; ///< --fast-peaks: the fast filter's peak split (0 = off)
     int fast_sh_bands = 24; ///< --fast-sh-bands: the fast filter's rough levels by spherical harmonics, at most N bands (0 = off)
+    bool fast_mid_tail = true; ///< --fast-mid-tail: the fast filter's intermediate coarse tail (ibl::prefilter_options::mid_tail)
     runtime_choice runtime = runtime_choice::split_sum;
     std::string lookup;        ///< --lookup DIR: query mode (lookup.hpp)
     std::string probes;        ///< --probes: bake this probe set (io/probes_reader.hpp, stages/probe_bake.hpp)

@@ -165,7 +165,8 @@ void run_probe_bake(const bake_options& opt, std::FILE* out) {
         read_source(po, src);
         if (opt.mirror) mirror_source(src);
         const ibl::cubemap<float> source = bake_source(src, plan.source_size, qs.bake_k, ex);
-        const ibl::cubemap<float> chain = bake_chain(source, plan.specular, opt.ld_weight, ex, opt.prefilter, opt.fast_peaks, opt.fast_sh_bands);
+        const ibl::cubemap<float> chain = bake_chain(source, plan.specular, opt.ld_weight, ex, opt.prefilter, opt.fast_peaks, opt.fast_sh_bands,
+                                                     opt.fast_mid_tail);
         baked[i].radiance = ibl::project_cube<3>(
             source.size(0), [&](int f, int x, int y) { return dvec3(source.texel(f, x, y, 0)); }, ex);
         baked[i].irradiance = ibl::sh_irradiance(baked[i].radiance);

@@ -450,8 +450,9 @@ std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, 
 
 /// Virtual levels [first, first + count) of the chain (sizes base >> v) with per-level samples and the LD weight w.
 ibl::prefilter_options chain_options(const ibl::specular_plan& sp, ibl::ld_weight w, prefilter_choice method, std::uint32_t fast_peaks,
-                                     int fast_sh_bands) {
+                                     int fast_sh_bands, bool fast_mid_tail) {
     ibl::prefilter_options o;
+    o.mid_tail.enabled = fast_mid_tail;
     o.peaks.enabled = fast_peaks > 0;
     o.peaks.max_peaks = fast_peaks;
     o.sh_rough.enabled = fast_sh_bands > 0;
@@ -467,8 +468,8 @@ ibl::prefilter_options chain_options(const ibl::specular_plan& sp, ibl::ld_weigh
 }
 
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
-                               prefilter_choice method, std::uint32_t fast_peaks, int fast_sh_bands) {
-    return ibl::cubemap<float>(ibl::prefilter(src, chain_options(sp, w, method, fast_peaks, fast_sh_bands), ex));
+                               prefilter_choice method, std::uint32_t fast_peaks, int fast_sh_bands, bool fast_mid_tail) {
+    return ibl::cubemap<float>(ibl::prefilter(src, chain_options(sp, w, method, fast_peaks, fast_sh_bands, fast_mid_tail), ex));
 }
 
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex) {

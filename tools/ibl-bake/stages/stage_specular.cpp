@@ -84,13 +84,20 @@ public:
         ctx.prog.begin("prefilter");
         weight_ = ctx.opt.ld_weight;
         method_ = ctx.opt.prefilter;
-        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands);
+        ctx.chain = bake_chain(ctx.source, ctx.plan.specular, weight_, ctx.ex, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands,
+                               ctx.opt.fast_mid_tail);
         if (method_ == prefilter_choice::fast) { // the bands of each level by spherical harmonics (0: its tap set)
             const ibl::prefilter_options po =
-                chain_options(ctx.plan.specular, weight_, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands);
+                chain_options(ctx.plan.specular, weight_, method_, ctx.opt.fast_peaks, ctx.opt.fast_sh_bands, ctx.opt.fast_mid_tail);
             sh_bands_.clear();
-            for (const ibl::prefilter_level& lp : po.level_plan) sh_bands_.push_back(ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(po, lp));
+            mid_roughness_.clear();
+            const int first_size = std::max(1, po.base_size >> po.level_plan.front().level);
+            for (std::size_t k = 0; k < po.level_plan.size(); ++k) {
+                sh_bands_.push_back(ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(po, po.level_plan[k]));
+                mid_roughness_.push_back(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(po, po.level_plan, k, first_size, true));
+            }
             sh_max_bands_ = ctx.opt.fast_sh_bands;
+            mid_tail_ = ctx.opt.fast_mid_tail;
         }
         ms_ = ctx.prog.end();
         if (method_ == prefilter_choice::fast && ctx.opt.fast_peaks > 0) { // the split again, for the report (untimed)
@@ -159,6 +166,8 @@ private:
     ibl::ld_weight weight_ = ibl::ld_weight::n_dot_l;
     prefilter_choice method_ = prefilter_choice::fis;
     std::vector<int> sh_bands_; ///< per stored level, the fast filter's spherical-harmonic bands (0: taps)
+    std::vector<double> mid_roughness_; ///< per stored level, the fast filter's intermediate level's roughness (-1: none)
+    bool mid_tail_ = false;
     int sh_max_bands_ = 0;
     struct peak_report {
         bool on = false;
@@ -292,6 +301,9 @@ void specular_stage::report(json_writer& j) const {
                                                         "read from the exact-solid-angle mips; coarse tail: each level's kernel tail "
                                                         "read from the next level of face >= 16") +
                                                 (peaks_.on ? "; peak split: the brightest texels added back exactly through the LD kernel" : "") +
+                                                (mid_tail_ ? "; intermediate coarse tail: a level at r <= 0.3 reads its tail from a "
+                                                             "half-size level between it and the next, where that face resolves its kernel"
+                                                           : "") +
                                                 (sh_max_bands_ > 0 ? "; rough levels by spherical-harmonic convolution of the source), "
                                                                    : "), ")
                                           : "GGX filtered importance sampling (Krivanek-Colbert), ") +
@@ -310,6 +322,12 @@ void specular_stage::report(json_writer& j) const {
         j.key("sh_levels").begin_object().key("max_bands").value(sh_max_bands_).key("tolerance").value(ibl::sh_rough_options{}.tolerance);
         j.key("bands_per_level").begin_array();
         for (const int b : sh_bands_) j.value(b);
+        j.end_array().end_object();
+        j.key("mid_tail").begin_object().key("enabled").value(mid_tail_).key("mid_roughness_per_level").begin_array();
+        for (const double r : mid_roughness_) {
+            if (r >= 0.0) j.value(r);
+            else j.null();
+        }
         j.end_array().end_object();
         j.key("peaks").begin_object().key("enabled").value(peaks_.on);
         if (peaks_.on)

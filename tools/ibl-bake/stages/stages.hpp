@@ -237,10 +237,11 @@ std::uint32_t chain_samples(std::uint32_t fis_samples, prefilter_choice method, 
 /// fast_peaks: the fast filter's peak split (ibl::peak_split_options::max_peaks; 0 = off);
 /// fast_sh_bands: its rough levels by spherical harmonics (ibl::sh_rough_options::max_bands; 0 = off).
 ibl::cubemap<float> bake_chain(const ibl::cubemap<float>& src, const ibl::specular_plan& sp, ibl::ld_weight w, pool_executor& ex,
-                               prefilter_choice method = prefilter_choice::fis, std::uint32_t fast_peaks = 1024, int fast_sh_bands = 24);
+                               prefilter_choice method = prefilter_choice::fis, std::uint32_t fast_peaks = 1024, int fast_sh_bands = 24,
+                               bool fast_mid_tail = true);
 /// The prefilter options bake_chain filters with.
 ibl::prefilter_options chain_options(const ibl::specular_plan& sp, ibl::ld_weight w, prefilter_choice method, std::uint32_t fast_peaks,
-                                     int fast_sh_bands);
+                                     int fast_sh_bands, bool fast_mid_tail = true);
 
 /// The raw 3-band SH projection of a cube's level 0 as a diffuse product.
 diffuse_data sh3_diffuse(const ibl::cubemap<float>& src, pool_executor& ex);
