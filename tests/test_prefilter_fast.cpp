@@ -329,6 +329,9 @@ TEST_CASE("fast intermediate coarse tail: only where its face resolves its kerne
           doctest::Approx(0.22));
     CHECK(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(on, ibl::prefilter_plan(on, 256), 2, 256, true) < 0.0); // r = 0.4 > max_roughness
     CHECK(ibl::detail::prefilter_mid_roughness<ibl::charlie_lobe>(on, ibl::prefilter_plan(on, 256), 1, 256, true) < 0.0);
+    ibl::prefilter_options few = on; // 8 samples at level 1: 3 of its own, below min_own_samples
+    few.samples = 8;
+    CHECK(ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(few, ibl::prefilter_plan(few, 256), 1, 256, true) < 0.0);
     check_same_bits(ibl::prefilter(small, on, ibl::thread_executor{2}), ibl::prefilter(small, off, ibl::thread_executor{2}));
     // Forced at 64^2 (min_texels lowered): only level 1 changes, and the update gives the same bits.
     ibl::prefilter_options forced = on;

@@ -177,8 +177,9 @@ struct prefilter_options {
     /// from the next level, and spends `own` times its samples on the narrower rest of its kernel
     /// (the defaults: 24 + 64 / 4 = 40 taps a texel instead of 64). Only where that face resolves
     /// the intermediate kernel: its full width at half maximum spans at least min_texels texels
-    /// (a 256^2 chain's level 1, not a 128^2 one's). The intermediate level is not part of the
-    /// output. enabled = false reads the next level directly.
+    /// (a 256^2 chain's level 1, not a 128^2 one's), and where the own tap set keeps at least
+    /// min_own_samples (16: not at --quality low's 8 samples, where 3 own samples miss the core).
+    /// The intermediate level is not part of the output. enabled = false reads the next level directly.
     struct mid_tail_options {
         bool enabled = true;
         double max_roughness = 0.3;
@@ -186,6 +187,7 @@ struct prefilter_options {
         double own = 0.375;
         double mid = 1.0;
         double min_texels = 3.0;
+        std::uint32_t min_own_samples = 16;
     } mid_tail{};
     /// The fast filter's rough levels by spherical-harmonic convolution (bake/prefilter_sh.hpp):
     /// read by method = fast on a cubemap source; a level whose kernel needs at most
@@ -453,6 +455,16 @@ template <class Lobe> double prefilter_tail_roughness(const prefilter_options& o
     if (k + 1 >= 31 || (first_size >> (k + 1)) < prefilter_coarse_tail_min_face) return -1.0;
     return std::clamp(std::isfinite(plan[k + 1].roughness) ? plan[k + 1].roughness : 0.0, 0.0, 1.0);
 }
+/// The samples of a level that reads an intermediate level: its own tap set's (own times s, at
+/// least 1) and the intermediate level's (mid times s, at least 1, at most limits::max_samples).
+inline std::uint32_t prefilter_mid_own_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
+    return std::uint32_t(std::clamp(std::lround(std::min(opt.mid_tail.own, 1.0) * double(std::max<std::uint32_t>(s, 1))), 1L,
+                                    long(std::max<std::uint32_t>(s, 1))));
+}
+inline std::uint32_t prefilter_mid_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
+    const double v = std::min(opt.mid_tail.mid * double(std::max<std::uint32_t>(s, 1)), double(limits::max_samples));
+    return std::uint32_t(std::max(1.0, std::round(v)));
+}
 /// The roughness of the intermediate level that plan level k reads its coarse tail from
 /// (prefilter_options::mid_tail; cubemap sources), or -1 when it reads the next level directly or
 /// has no coarse tail.
@@ -465,22 +477,13 @@ template <class Lobe> double prefilter_mid_roughness(const prefilter_options& op
     if (rn < 0.0) return -1.0;
     const double r = std::clamp(std::isfinite(plan[k].roughness) ? plan[k].roughness : 0.0, 0.0, 1.0);
     if (!(r <= m.max_roughness) || !(rn > r)) return -1.0;
+    if (prefilter_mid_own_samples(opt, plan[k].samples) < m.min_own_samples) return -1.0;
     const double rm = r + m.position * (rn - r);
     // the intermediate level's face (the next level's) resolves its kernel: a texel at the face
     // centre is 2 / face radians
     const int face = std::max(1, first_size >> int(k + 1));
     if (!(ggx_ld_fwhm(rm) >= (std::isfinite(m.min_texels) ? m.min_texels : 3.0) * 2.0 / double(face))) return -1.0;
     return rm;
-}
-/// The samples of a level that reads an intermediate level: its own tap set's (own times s, at
-/// least 1) and the intermediate level's (mid times s, at least 1, at most limits::max_samples).
-inline std::uint32_t prefilter_mid_own_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
-    return std::uint32_t(std::clamp(std::lround(std::min(opt.mid_tail.own, 1.0) * double(std::max<std::uint32_t>(s, 1))), 1L,
-                                    long(std::max<std::uint32_t>(s, 1))));
-}
-inline std::uint32_t prefilter_mid_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
-    const double v = std::min(opt.mid_tail.mid * double(std::max<std::uint32_t>(s, 1)), double(limits::max_samples));
-    return std::uint32_t(std::max(1.0, std::round(v)));
 }
 /// prefilter's work check with the intermediate levels (mid_tail) of a cubemap source: the plan's
 /// taps (check_prefilter_work) plus 6 n_m^2 samples_m of each intermediate level.
