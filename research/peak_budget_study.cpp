@@ -61,7 +61,7 @@ void run_study(const std::string& name, const ibl::cubemap<float>& src, const st
             const ibl::cube_peak_split<float> s = ibl::detail::find_cube_peaks(src, v.opt.peaks, ex);
             const ibl::peak_level pl = ibl::make_peak_level(s.peaks, size, src.levels(), plan[1].roughness, v.opt.weight,
                                                             v.opt.peaks.footprint, v.opt.peaks.max_merge_angle, s.mean_luminance,
-                                                            v.opt.peaks.cut, v.opt.peaks.max_level_peaks);
+                                                            v.opt.peaks.cut, v.opt.peaks.max_level_peaks, v.opt.peaks.max_level_steps);
             char b[64];
             std::snprintf(b, sizeof b, "%zu of %zu", pl.size(), s.peaks.size());
             peaks = b;
@@ -96,7 +96,8 @@ int main(int argc, char** argv) {
         variants.push_back(v);
     };
     if (!quick) variants.push_back({"FIS default", {}});
-    fast("fast default (max_level_peaks 128)", [](ibl::prefilter_options&) {});
+    fast("fast default (max_level_peaks 128, 2 steps)", [](ibl::prefilter_options&) {});
+    fast("fast, max_level_peaks 128, 1 step", [](ibl::prefilter_options& o) { o.peaks.max_level_steps = 1; });
     fast("fast, every merged peak (max_level_peaks 0)", [](ibl::prefilter_options& o) { o.peaks.max_level_peaks = 0; });
     fast("fast, max_level_peaks 32", [](ibl::prefilter_options& o) { o.peaks.max_level_peaks = 32; });
     fast("fast, max_peaks 64 (threshold raised)", [](ibl::prefilter_options& o) { o.peaks.max_peaks = 64; });

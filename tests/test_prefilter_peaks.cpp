@@ -261,7 +261,7 @@ TEST_CASE("peak split: the packed patch equals packing the split's base cube, bi
     CHECK_FALSE(ibl::detail::patch_packed_peaks(po, odd, so.peaks, so.threshold));
 }
 
-TEST_CASE("peak split: a level above max_level_peaks merges one mip coarser, keeping the energy; the row cut stays within its bound") {
+TEST_CASE("peak split: a level above max_level_peaks merges coarser, max_level_steps mips at most, keeping the energy; the row cut stays within its bound") {
     // A grey cube with an extended bright patch (1600 texels at 60 x the grey): about 1024 peaks.
     constexpr int n = 128;
     ibl::cubemap<float> src(n);
@@ -292,6 +292,17 @@ TEST_CASE("peak split: a level above max_level_peaks merges one mip coarser, kee
         CHECK(pl.size() < all.size());
         CHECK(energy(pl) == doctest::Approx(energy(all)).epsilon(1e-5));
     }
+    // two steps (prefilter's default, max_level_steps): a second mip coarser while still above the cap
+    const std::size_t two = ibl::merge_cube_peaks(s.peaks, mip + 2).size();
+    REQUIRE(coarser > 16);
+    const ibl::peak_level pl16 = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
+                                                      po.max_merge_angle, s.mean_luminance, po.cut, 16, po.max_level_steps);
+    CHECK(po.max_level_steps == 2);
+    CHECK(pl16.size() == two);
+    CHECK(energy(pl16) == doctest::Approx(energy(all)).epsilon(1e-5));
+    const ibl::peak_level pl_cap = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
+                                                        po.max_merge_angle, s.mean_luminance, po.cut, std::uint32_t(coarser), 2);
+    CHECK(pl_cap.size() == coarser); // at the cap after one step: no second
     const ibl::peak_level roomy = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
                                                        po.max_merge_angle, s.mean_luminance, po.cut, std::uint32_t(all.size()));
     CHECK(roomy.size() == all.size()); // at the cap: the footprint rule's merge

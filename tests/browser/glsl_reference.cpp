@@ -966,7 +966,7 @@ void print_prefilter_fixtures() {
                 split.empty() ? ibl::peak_level{}
                               : ibl::make_peak_level(split.peaks, size, base.levels(), lp.roughness, o.weight,
                                                      o.peaks.footprint, o.peaks.max_merge_angle, split.mean_luminance,
-                                                     o.peaks.cut, o.peaks.max_level_peaks);
+                                                     o.peaks.cut, o.peaks.max_level_peaks, o.peaks.max_level_steps);
             std::printf("], \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"next_roughness\": %.17g, \"tail_share\": %.9g, "
                         "\"next_n\": %d",
                         pl.size(), double(pl.a2), pl.g1 ? "true" : "false", rn, double(float(tail.share)),

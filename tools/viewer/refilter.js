@@ -278,7 +278,7 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed, ne
 
 /// peak_split_options' defaults (the C++ prefilter's; its row cut has no GPU counterpart: the GPU
 /// adds every peak of the list, what the C++ adds with cut = 0).
-export const peakDefaults = { ratio: 16, maxPeaks: 1024, footprint: 6, maxMergeAngle: 1 / 16, maxLevelPeaks: 128 };
+export const peakDefaults = { ratio: 16, maxPeaks: 1024, footprint: 6, maxMergeAngle: 1 / 16, maxLevelPeaks: 128, maxLevelSteps: 2 };
 
 const luminance = (c) => 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
 
@@ -366,7 +366,7 @@ function peakMergeMip(r, n0, maxMip, footprint, maxAngle) {
 }
 
 /// make_peak_level: a level's peaks for ibl_prefilter_peaks (the split's peaks of an n0-texel level 0
-/// with `sourceLevels` mips, merged at peakMergeMip, one mip coarser above maxLevelPeaks, energies pre-scaled by alpha^2 / (4 pi
+/// with `sourceLevels` mips, merged at peakMergeMip, a mip coarser while above maxLevelPeaks (maxLevelSteps times at most), energies pre-scaled by alpha^2 / (4 pi
 /// integral K)): { peak_count, peaks: Float32Array (x, y, z, er, eg, eb per peak), a2, g1 }.
 export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = peakDefaults) {
     const none = { peak_count: 0, peaks: new Float32Array(0), a2: 0, g1: false };
@@ -376,11 +376,13 @@ export function makePeakLevel(peaks, n0, sourceLevels, roughness, weight, opt = 
     const norm = 2 * Math.PI * radialCdf(r, weight).total;
     if (!(norm > 0)) return none;
     const scale = a2 / (4 * Math.PI * norm);
-    // More than maxLevelPeaks merged peaks: merged one mip coarser (a texel at most maxMergeAngle).
+    // More than maxLevelPeaks merged peaks: merged a mip coarser, maxLevelSteps times at most (a
+    // texel at most maxMergeAngle).
     let mip = peakMergeMip(r, n0, sourceLevels - 1, opt.footprint, opt.maxMergeAngle);
     let merged = mergePeaks(peaks, mip);
-    if (opt.maxLevelPeaks > 0 && merged.length > opt.maxLevelPeaks && mip < sourceLevels - 1 && (n0 >> (mip + 1)) >= 1 &&
-        2 / (n0 >> (mip + 1)) <= opt.maxMergeAngle)
+    const steps = opt.maxLevelSteps ?? 1;
+    for (let step = 0; step < steps && opt.maxLevelPeaks > 0 && merged.length > opt.maxLevelPeaks && mip < sourceLevels - 1 &&
+         (n0 >> (mip + 1)) >= 1 && 2 / (n0 >> (mip + 1)) <= opt.maxMergeAngle; ++step)
         merged = mergePeaks(peaks, ++mip);
     const out = new Float32Array(6 * merged.length);
     merged.forEach((p, j) => {

@@ -724,7 +724,8 @@ public:
     [[nodiscard]] peak_level level_peaks(const prefilter_level& lp) const {
         if (peaks_.empty()) return {};
         return make_peak_level(peaks_, n0_, table_source_levels_, lp.roughness, opt_.weight, opt_.peaks.footprint,
-                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut, opt_.peaks.max_level_peaks);
+                               opt_.peaks.max_merge_angle, mean_, opt_.peaks.cut, opt_.peaks.max_level_peaks,
+                               opt_.peaks.max_level_steps);
     }
     /// Row `row` (face n + y) of an n x n level: the tap set, then the coarse tail from `next` (the
     /// next level without its peaks; lv.tail_share > 0), then the peaks. base_out (when not null)

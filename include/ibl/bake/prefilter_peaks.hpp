@@ -36,8 +36,9 @@
 // so a source with nothing above ratio times its mean has no peaks and filters exactly as without
 // the split, and the cost of the exact part is bounded: at most max_peaks kernel evaluations per
 // output texel, and fewer after the merge: a level with more than max_level_peaks (128) merged
-// peaks merges them one mip coarser (merged texels up to twice the footprint rule's, at most
-// max_merge_angle); peaks behind a row's hemisphere, and the faintest within the row cut, are
+// peaks merges them a mip coarser while it has more, max_level_steps (2) times at most (merged
+// texels up to 4x the footprint rule's, at most max_merge_angle); peaks behind a row's hemisphere,
+// and the faintest within the row cut, are
 // skipped per row. Each evaluation is about ten float operations, vectorised over a face row.
 // Many peaks mean an extended bright region, each of its texels faint next to the whole (the
 // courtyard's 1024 brightest texels carry 0.4 % of its energy); there the coarser merge changes no
@@ -93,10 +94,14 @@ struct peak_split_options {
     /// row's darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
     /// peak that is in front of some texel of the row (the GPU filter's sum).
     double cut = 1e-3;
-    /// A level with more merged peaks than this (0: no limit) merges them one mip coarser (its
-    /// merged texels up to twice the footprint rule's, at most max_merge_angle): many peaks are
-    /// an extended bright region.
+    /// A level with more merged peaks than this (0: no limit) merges them one mip coarser, again
+    /// while there are still more, at most max_level_steps mips (its merged texels up to 2^steps
+    /// times the footprint rule's, at most max_merge_angle): many peaks are an extended bright
+    /// region, each of its texels faint next to the whole. Two steps rather than one: a 128^2
+    /// chain's level 1 on the courtyard evaluates 94 merged peaks a texel instead of 307, with
+    /// the same error (docs/ibl-bake.md, "Fast filter").
     std::uint32_t max_level_peaks = 128;
+    std::uint32_t max_level_steps = 2;
 };
 
 /// One peak: its direction (unit) and its energy (Omega times the radiance above the threshold).
@@ -403,7 +408,7 @@ struct peak_level {
 /// GGX lobe at roughness r and the LD weight.
 inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
                                   ld_weight weight, double footprint, double max_angle, double mean_luminance,
-                                  double cut = 1e-3, std::uint32_t max_level_peaks = 0) {
+                                  double cut = 1e-3, std::uint32_t max_level_peaks = 0, std::uint32_t max_level_steps = 1) {
     peak_level pl;
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);
@@ -413,10 +418,12 @@ inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, i
     const double scale = a2 / (4.0 * pi_v<double> * norm);
     int mip = peak_merge_mip(r, n0, source_levels - 1, footprint, max_angle);
     std::vector<cube_peak> merged = merge_cube_peaks(peaks, mip);
-    // Too many: one mip coarser at most (merged texels up to twice the footprint rule's, never
-    // above max_angle: a rough level's horizon cut is what that bound protects).
-    if (max_level_peaks > 0 && merged.size() > max_level_peaks && mip < source_levels - 1 && (n0 >> (mip + 1)) >= 1 &&
-        2.0 / double(n0 >> (mip + 1)) <= max_angle)
+    // Too many: a mip coarser, at most max_level_steps times (merged texels up to 2^steps times
+    // the footprint rule's, never above max_angle: a rough level's horizon cut is what that bound
+    // protects).
+    for (std::uint32_t step = 0; step < max_level_steps && max_level_peaks > 0 && merged.size() > max_level_peaks &&
+                                 mip < source_levels - 1 && (n0 >> (mip + 1)) >= 1 && 2.0 / double(n0 >> (mip + 1)) <= max_angle;
+         ++step)
         merged = merge_cube_peaks(peaks, ++mip);
     for (const cube_peak& p : merged) {
         pl.px.push_back(p.dir.x), pl.py.push_back(p.dir.y), pl.pz.push_back(p.dir.z);
