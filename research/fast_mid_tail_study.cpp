@@ -33,6 +33,7 @@
 #include <ibl/env/convert.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
 
+#include "blocks_env.hpp"
 #include "ld_study.hpp"
 
 namespace {
@@ -51,21 +52,6 @@ struct setting {
     }
     [[nodiscard]] double taps() const { return on ? 64.0 * own + 16.0 * mid : 64.0; }
 };
-
-/// The synthetic source of the unit test: a sky of 30 with blocks of 60 over a ground of 0.5 with
-/// stripes of 2, its pattern in units of 1/64 of a face.
-ibl::cubemap<float> blocks(int n) {
-    const int sc = std::max(1, n / 64);
-    ibl::cubemap<float> src(n);
-    src.fill(0, [&](int f, int x, int y) {
-        const ibl::vec3<float> d = ibl::cube_texel_direction<float>(f, x, y, n);
-        const int X = x / sc, Y = y / sc;
-        const bool stripe = ((X / 3 + Y / 2) % 3 == 0), cloud = ((X / 5 + 2 * (Y / 4)) % 4 == 0);
-        return ibl::vec3<float>(d.y > 0.f ? (cloud ? 60.f : 30.f) : (stripe ? 2.f : 0.5f));
-    });
-    src.generate_mips();
-    return src;
-}
 
 } // namespace
 
@@ -119,7 +105,7 @@ int main(int argc, char** argv) {
     for (const int size : sizes) {
         if (!args.quick) {
             measure("sky + sun", ibl::bake_cubemap<float>(ibl::make_default_sky<double>(), size, 4, ex));
-            measure("blocks", blocks(size));
+            measure("blocks", study::blocks_env(size));
         }
         for (const std::string& file : args.files) {
             const ibl::latlong<float> map = ld_study::load_latlong(file);

@@ -13,6 +13,8 @@
 #include <ibl/env/cubemap.hpp>
 #include <ibl/reference/ld_irradiance.hpp>
 
+#include "../research/blocks_env.hpp"
+
 #include <array>
 #include <cmath>
 #include <cstring>
@@ -304,18 +306,7 @@ TEST_CASE("fast coarse tail: lower error than the tap set alone on a sky over a 
 TEST_CASE("fast intermediate coarse tail: only where its face resolves its kernel; only level 1 changes; same bits in the update") {
     // A bright sky with clouds over a textured dark ground (blocks of 1/64 of a face, at any size),
     // filtered to the 6-level chain (r = l / 5): level 1 (r = 0.2) reads its tail from level 2.
-    auto make = [](int n) {
-        const int sc = std::max(1, n / 64);
-        ibl::cubemap<float> src(n);
-        src.fill(0, [&](int f, int x, int y) {
-            const ibl::vec3<float> d = ibl::cube_texel_direction<float>(f, x, y, n);
-            const int X = x / sc, Y = y / sc;
-            const bool stripe = ((X / 3 + Y / 2) % 3 == 0), cloud = ((X / 5 + 2 * (Y / 4)) % 4 == 0);
-            return ibl::vec3<float>(d.y > 0.f ? (cloud ? 60.f : 30.f) : (stripe ? 2.f : 0.5f));
-        });
-        src.generate_mips();
-        return src;
-    };
+    auto make = [](int n) { return study::blocks_env(n); }; // research/blocks_env.hpp
     ibl::prefilter_options on = fast_options(), off = on;
     on.levels = off.levels = 6;
     off.mid_tail.enabled = false;
