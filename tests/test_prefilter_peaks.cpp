@@ -283,11 +283,11 @@ TEST_CASE("peak split: a level above max_level_peaks merges coarser, max_level_s
     const int mip = ibl::peak_merge_mip(0.2, n, src.levels() - 1, po.footprint, po.max_merge_angle);
     CHECK(all.size() == ibl::merge_cube_peaks(s.peaks, mip).size());
     CHECK(all.size() > 128);
-    // above the cap: merged one mip coarser (and no further)
+    // above the cap with one step allowed: merged one mip coarser (and no further)
     const std::size_t coarser = ibl::merge_cube_peaks(s.peaks, mip + 1).size();
     for (const std::uint32_t cap : {128u, 16u}) {
         const ibl::peak_level pl = ibl::make_peak_level(s.peaks, n, src.levels(), 0.2, ibl::ld_weight::n_dot_l, po.footprint,
-                                                        po.max_merge_angle, s.mean_luminance, po.cut, cap);
+                                                        po.max_merge_angle, s.mean_luminance, po.cut, cap, 1);
         CHECK(pl.size() == coarser);
         CHECK(pl.size() < all.size());
         CHECK(energy(pl) == doctest::Approx(energy(all)).epsilon(1e-5));

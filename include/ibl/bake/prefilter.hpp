@@ -87,9 +87,11 @@
 #include <cstddef>
 #include <cstdint>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "../brdf/ggx.hpp"
@@ -416,18 +418,22 @@ inline void check_level_plan(const std::vector<prefilter_level>& plan) {
     }
 }
 
-/// prefilter's checks, before any table is built: the sample counts of the options or of the
-/// given plan, and the total taps of the plan's levels >= 1 within limits::max_work.
-inline void check_prefilter_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int base) {
-    if (opt.level_plan.empty()) check_prefilter_samples(opt);
-    else check_level_plan(plan);
+/// The taps of the plan's levels >= 1: the sum of 6 n_l^2 samples_l (x 2 when trilinear).
+inline std::uint64_t prefilter_plan_work(const std::vector<prefilter_level>& plan, int base) {
     std::uint64_t work = 0;
     for (const prefilter_level& lp : plan) {
         if (lp.level < 1) continue;
         const std::uint64_t n = std::uint64_t(base >> lp.level > 0 ? base >> lp.level : 1);
         work = work_add(work, 6 * n * n, std::uint64_t(lp.samples) * (lp.trilinear ? 2u : 1u));
     }
-    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l)", work, limits::max_work, "limits::max_work");
+    return work;
+}
+/// prefilter's checks, before any table is built: the sample counts of the options or of the
+/// given plan, and the total taps of the plan's levels >= 1 within limits::max_work.
+inline void check_prefilter_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int base) {
+    if (opt.level_plan.empty()) check_prefilter_samples(opt);
+    else check_level_plan(plan);
+    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l)", prefilter_plan_work(plan, base), limits::max_work, "limits::max_work");
 }
 } // namespace detail
 
@@ -458,8 +464,7 @@ template <class Lobe> double prefilter_tail_roughness(const prefilter_options& o
 /// The samples of a level that reads an intermediate level: its own tap set's (own times s, at
 /// least 1) and the intermediate level's (mid times s, at least 1, at most limits::max_samples).
 inline std::uint32_t prefilter_mid_own_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
-    return std::uint32_t(std::clamp(std::lround(std::min(opt.mid_tail.own, 1.0) * double(std::max<std::uint32_t>(s, 1))), 1L,
-                                    long(std::max<std::uint32_t>(s, 1))));
+    return std::max(1u, std::uint32_t(std::round(std::clamp(opt.mid_tail.own, 0.0, 1.0) * double(s))));
 }
 inline std::uint32_t prefilter_mid_samples(const prefilter_options& opt, std::uint32_t s) noexcept {
     const double v = std::min(opt.mid_tail.mid * double(std::max<std::uint32_t>(s, 1)), double(limits::max_samples));
@@ -485,21 +490,20 @@ template <class Lobe> double prefilter_mid_roughness(const prefilter_options& op
     if (!(ggx_ld_fwhm(rm) >= (std::isfinite(m.min_texels) ? m.min_texels : 3.0) * 2.0 / double(face))) return -1.0;
     return rm;
 }
-/// prefilter's work check with the intermediate levels (mid_tail) of a cubemap source: the plan's
-/// taps (check_prefilter_work) plus 6 n_m^2 samples_m of each intermediate level.
-template <class Lobe> void check_prefilter_mid_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int first_size) {
-    std::uint64_t work = 0;
-    for (std::size_t k = 0; k < plan.size(); ++k) {
-        const prefilter_level& lp = plan[k];
-        if (lp.level < 1 && lobe_mirror_limit<Lobe>()) continue;
-        const std::uint64_t n = std::uint64_t(std::max(1, first_size >> int(k)));
-        work = work_add(work, 6 * n * n, std::uint64_t(lp.samples) * (lp.trilinear ? 2u : 1u));
+/// prefilter's work check with the intermediate levels (mid_tail) of a cubemap source, after
+/// check_prefilter_work: the plan's taps plus 6 n_m^2 samples_m of each intermediate level (its
+/// face n_m the next level's), within limits::max_work.
+template <class Lobe> void check_prefilter_mid_work(const prefilter_options& opt, const std::vector<prefilter_level>& plan, int base) {
+    const int first_size = std::max(1, base >> plan.front().level);
+    std::uint64_t mids = 0;
+    for (std::size_t k = 0; k < plan.size(); ++k)
         if (prefilter_mid_roughness<Lobe>(opt, plan, k, first_size, true) >= 0.0) {
-            const std::uint64_t m = std::max<std::uint64_t>(1, n / 2);
-            work = work_add(work, 6 * m * m, std::uint64_t(prefilter_mid_samples(opt, lp.samples)) * (lp.trilinear ? 2u : 1u));
+            const std::uint64_t m = std::uint64_t(std::max(1, first_size >> int(k + 1)));
+            mids = work_add(mids, 6 * m * m, std::uint64_t(prefilter_mid_samples(opt, plan[k].samples)) * (plan[k].trilinear ? 2u : 1u));
         }
-    }
-    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l, intermediate levels included)", work, limits::max_work, "limits::max_work");
+    if (mids == 0) return;
+    check_total("prefilter", "taps (sum of 6 n_l^2 samples_l, intermediate levels included)",
+                work_add(prefilter_plan_work(plan, base), 1, mids), limits::max_work, "limits::max_work");
 }
 /// The order prefilter computes the plan's levels in: coarse to fine when a level reads its
 /// coarse tail, else fine to coarse.
@@ -572,13 +576,12 @@ public:
             const double rn = prefilter_tail_roughness<Lobe>(opt_, plan, k, out_size, true);
             const double rm = prefilter_mid_roughness<Lobe>(opt_, plan, k, out_size, true);
             // the level's table, and its intermediate level's (mid_tail), as level() builds them
-            for (int part = 0; part < (rm >= 0.0 ? 2 : 1); ++part) {
-                prefilter_level t = lp;
-                double next = rn;
-                if (rm >= 0.0 && part == 0) t.samples = prefilter_mid_own_samples(opt_, lp.samples), next = rm;
-                if (part == 1) t.roughness = rm, t.samples = prefilter_mid_samples(opt_, lp.samples);
-                if (part == 1 && prefilter_sh_bands<Lobe>(opt_, t) > 0) {
-                    bands = std::max(bands, prefilter_sh_bands<Lobe>(opt_, t));
+            const std::pair<prefilter_level, double> one[] = {{lp, rn}};
+            const std::pair<prefilter_level, double> two[] = {{mid_owner(lp), rm}, {mid_of(lp, rm), rn}};
+            for (const auto& [t, next] : rm >= 0.0 ? std::span<const std::pair<prefilter_level, double>>(two)
+                                                   : std::span<const std::pair<prefilter_level, double>>(one)) {
+                if (const int b = prefilter_sh_bands<Lobe>(opt_, t); b > 0) { // an intermediate level by spherical harmonics
+                    bands = std::max(bands, b);
                     continue;
                 }
                 sphere_sample_table<float> table =
@@ -706,13 +709,18 @@ public:
     /// it adds them through its own kernel). Its face nm is the next level's (half of lp's).
     template <class Env, class Executor>
     prefilter_cube_level mid_level(const Env& env, const prefilter_level& lp, double rm, double rn, int nm, Executor& ex) const {
+        prefilter_cube_level lv = level(env, mid_of(lp, rm), rn, nm, ex);
+        lv.peaks = {};
+        return lv;
+    }
+    /// The intermediate level of plan level lp as a plan level: the next level's face, roughness rm,
+    /// prefilter_mid_samples.
+    [[nodiscard]] prefilter_level mid_of(const prefilter_level& lp, double rm) const {
         prefilter_level m = lp;
         m.level = lp.level + 1;
         m.roughness = rm;
         m.samples = prefilter_mid_samples(opt_, lp.samples);
-        prefilter_cube_level lv = level(env, m, rn, nm, ex);
-        lv.peaks = {};
-        return lv;
+        return m;
     }
     /// Plan level lp with the samples of its own tap set when it reads an intermediate level.
     [[nodiscard]] prefilter_level mid_owner(const prefilter_level& lp) const {
@@ -789,8 +797,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
     const int base = detail::prefilter_base_size(env, opt.base_size);
     const std::vector<prefilter_level> plan = prefilter_plan<Lobe>(opt, base);
     detail::check_prefilter_work(opt, plan, base);
-    if constexpr (requires { detail::pack_cube(env); })
-        detail::check_prefilter_mid_work<Lobe>(opt, plan, std::max(1, base >> plan.front().level));
+    if constexpr (requires { detail::pack_cube(env); }) detail::check_prefilter_mid_work<Lobe>(opt, plan, base);
     // Every interior texel of every level is written below (by the workers, in place), then the borders.
     cubemap<float> out(std::max(1, base >> plan.front().level), int(plan.size()), detail::for_overwrite);
     // Coarse to fine when a level reads its coarse tail from the next (finished) level.

@@ -94,7 +94,7 @@ struct peak_split_options {
     /// row's darkest tap-set result (at least 1e-2 of the mean luminance) are skipped; 0 keeps every
     /// peak that is in front of some texel of the row (the GPU filter's sum).
     double cut = 1e-3;
-    /// A level with more merged peaks than this (0: no limit) merges them one mip coarser, again
+    /// A level with more merged peaks than this (0: no limit) merges them a mip coarser, again
     /// while there are still more, at most max_level_steps mips (its merged texels up to 2^steps
     /// times the footprint rule's, at most max_merge_angle): many peaks are an extended bright
     /// region, each of its texels faint next to the whole. Two steps rather than one: a 128^2
@@ -408,7 +408,7 @@ struct peak_level {
 /// GGX lobe at roughness r and the LD weight.
 inline peak_level make_peak_level(const std::vector<cube_peak>& peaks, int n0, int source_levels, double roughness,
                                   ld_weight weight, double footprint, double max_angle, double mean_luminance,
-                                  double cut = 1e-3, std::uint32_t max_level_peaks = 0, std::uint32_t max_level_steps = 1) {
+                                  double cut = 1e-3, std::uint32_t max_level_peaks = 0, std::uint32_t max_level_steps = 2) {
     peak_level pl;
     if (peaks.empty()) return pl;
     const double r = std::clamp(std::isfinite(roughness) ? roughness : 0.0, 0.0, 1.0);

@@ -473,10 +473,10 @@ private:
         const int base = detail::prefilter_base_size(*source_, opt_.base_size);
         plan_ = prefilter_plan<Lobe>(opt_, base);
         detail::check_prefilter_work(opt_, plan_, base);
+        detail::check_prefilter_mid_work<Lobe>(opt_, plan_, base);
         first_size_ = std::max(1, base >> plan_.front().level);
         // The projection of the levels by spherical harmonics (its rows: the pass's units after the packing).
         src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_));
-        detail::check_prefilter_mid_work<Lobe>(opt_, plan_, first_size_);
         levels_.clear();
         // The output levels at their plan index, then the intermediate levels (mid_tail), each
         // computed just before the level that reads it, as prefilter does.
