@@ -889,7 +889,9 @@ void print_fixtures() {
 /// (make_peak_level: direction and pre-scaled energy, a2, the weight; 4 peaks at level 1, merged to
 /// 2 from level 2), its spherical-harmonic texture when the level is reconstructed from the split's
 /// base's projection (prefilter_options::sh_rough, on by default: ibl_prefilter_sh's coefficients,
-/// norm and recurrence constants) and the chain's texels (face, row, column) the GLSL must reproduce.
+/// norm and recurrence constants), the intermediate level its coarse tail reads where the level has
+/// one (prefilter_options::mid_tail, forced here: its roughness, face and taps) and the chain's
+/// texels (face, row, column) the GLSL must reproduce.
 void print_prefilter_fixtures() {
     constexpr int size = 64, width = 256;
     const ibl::cubemap<float> src = ibl::bake_cubemap<float>(ibl::make_default_sky<float>(), size, 2);
@@ -897,7 +899,10 @@ void print_prefilter_fixtures() {
     o.method = ibl::prefilter_method::fast;
     o.peaks.enabled = true;
     o.peaks.cut = 0.0; // every peak in front of some texel of a row: the GLSL's plain sum over the list
-    o.mid_tail.enabled = false; // the GLSL filter reads every coarse tail from the next level (no intermediate level)
+    // The intermediate coarse tail (mid_tail) forced on this small chain: by default it starts at a
+    // 256^2 chain (the refilter test's --size 256 checks the default rule), and a 64^2 one puts it
+    // on level 1 (r = 0.22 on a 16^2 face, its tail from level 2) when min_texels is 0.
+    o.mid_tail.min_texels = 0.0;
     // What prefilter's cubemap source holds (detail::prefilter_cube_source): the split's base packed
     // when there are peaks, else the source.
     const ibl::cube_peak_split<float> split = ibl::split_cube_peaks(src, o.peaks, ibl::serial_executor{});
@@ -941,25 +946,45 @@ void print_prefilter_fixtures() {
             // The coarse tail (prefilter_options::coarse_tail): the rest kernel's taps and the share of
             // the next level (the GPU reads its own next level before its peaks, as the C++ does).
             const double rn = ibl::detail::prefilter_tail_roughness<ibl::ggx_lobe>(o, plan, l, size, true);
+            // With an intermediate level (rm >= 0) the level's tail reads it, and its own tap set has
+            // prefilter_mid_own_samples; the intermediate level's taps (prefilter_mid_samples at rm,
+            // its tail from the next level) are printed as the level's "mid".
+            const double rm = ibl::detail::prefilter_mid_roughness<ibl::ggx_lobe>(o, plan, l, size, true);
+            const double tail_r = rm >= 0.0 ? rm : rn;
+            const std::uint32_t own = rm >= 0.0 ? ibl::detail::prefilter_mid_own_samples(o, lp.samples) : lp.samples;
             const ibl::detail::fast_coarse_tail tail =
-                rn >= 0.0 ? ibl::detail::fast_tail_of<ibl::ggx_lobe>(lp.roughness, rn, o.weight) : ibl::detail::fast_coarse_tail{};
-            ibl::sphere_sample_table<float> table =
-                ibl::make_ld_table_for<float>(src, lp.roughness, lp.samples, o.method, o.lod_bias, o.weight, rn);
-            table.trilinear = lp.trilinear;
-            const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
+                tail_r >= 0.0 ? ibl::detail::fast_tail_of<ibl::ggx_lobe>(lp.roughness, tail_r, o.weight) : ibl::detail::fast_coarse_tail{};
+            const auto print_taps = [&](double r, std::uint32_t samples, double next_r) {
+                ibl::sphere_sample_table<float> table =
+                    ibl::make_ld_table_for<float>(src, r, samples, o.method, o.lod_bias, o.weight, next_r);
+                table.trilinear = lp.trilinear;
+                const ibl::detail::tap_table taps = ibl::detail::make_taps(table, int(packed.levels.size()));
+                std::printf("\"count\": %zu, \"factor\": %.9g, \"taps\": [", taps.w.size(), double(taps.factor));
+                for (std::size_t i = 0; i < taps.w.size(); ++i)
+                    std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]),
+                                double(taps.z[i]), double(taps.w[i]));
+                std::printf("], \"info\": [");
+                for (std::size_t i = 0; i < taps.w.size(); ++i) {
+                    const ibl::detail::packed_cube::level& lv = packed.levels[std::size_t(taps.level[i])];
+                    std::printf("%s%d, %d, %d, %d", i ? ", " : "", lv.n, lv.stride, lv.face_stride, lv.offset);
+                }
+                std::printf("]");
+            };
             const int n = chain.size(int(l));
-            std::printf("%s{\"level\": %d, \"n\": %d, \"roughness\": %.17g, \"samples\": %u, \"trilinear\": %s, "
-                        "\"weight\": \"%s\", \"count\": %zu, \"factor\": %.9g, \"taps\": [",
-                        first ? "" : ", ", int(l), n, lp.roughness, lp.samples, lp.trilinear ? "true" : "false",
-                        o.weight == ibl::ld_weight::g1 ? "g1" : "nl", taps.w.size(), double(taps.factor));
+            std::printf("%s{\"level\": %d, \"n\": %d, \"roughness\": %.17g, \"plan_samples\": %u, \"samples\": %u, "
+                        "\"trilinear\": %s, \"weight\": \"%s\", ",
+                        first ? "" : ", ", int(l), n, lp.roughness, lp.samples, own, lp.trilinear ? "true" : "false",
+                        o.weight == ibl::ld_weight::g1 ? "g1" : "nl");
             first = false;
-            for (std::size_t i = 0; i < taps.w.size(); ++i)
-                std::printf("%s%.9g, %.9g, %.9g, %.9g", i ? ", " : "", double(taps.x[i]), double(taps.y[i]),
-                            double(taps.z[i]), double(taps.w[i]));
-            std::printf("], \"info\": [");
-            for (std::size_t i = 0; i < taps.w.size(); ++i) {
-                const ibl::detail::packed_cube::level& lv = packed.levels[std::size_t(taps.level[i])];
-                std::printf("%s%d, %d, %d, %d", i ? ", " : "", lv.n, lv.stride, lv.face_stride, lv.offset);
+            print_taps(lp.roughness, own, tail_r);
+            if (rm >= 0.0) {
+                const std::uint32_t ms = ibl::detail::prefilter_mid_samples(o, lp.samples);
+                const ibl::detail::fast_coarse_tail mt = ibl::detail::fast_tail_of<ibl::ggx_lobe>(rm, rn, o.weight);
+                std::printf(", \"mid\": {\"roughness\": %.17g, \"n\": %d, \"samples\": %u, \"next_roughness\": %.17g, "
+                            "\"tail_share\": %.9g, ",
+                            rm, chain.size(int(l) + 1), ms, rn, double(float(mt.share)));
+                print_taps(rm, ms, rn);
+                std::printf("}");
             }
             // The level's peaks as the row kernel adds them (prefilter_cube_source::level_peaks).
             const ibl::peak_level pl =
@@ -967,9 +992,9 @@ void print_prefilter_fixtures() {
                               : ibl::make_peak_level(split.peaks, size, base.levels(), lp.roughness, o.weight,
                                                      o.peaks.footprint, o.peaks.max_merge_angle, split.mean_luminance,
                                                      o.peaks.cut, o.peaks.max_level_peaks, o.peaks.max_level_steps);
-            std::printf("], \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"next_roughness\": %.17g, \"tail_share\": %.9g, "
+            std::printf(", \"peak_count\": %zu, \"a2\": %.9g, \"g1\": %s, \"next_roughness\": %.17g, \"tail_share\": %.9g, "
                         "\"next_n\": %d",
-                        pl.size(), double(pl.a2), pl.g1 ? "true" : "false", rn, double(float(tail.share)),
+                        pl.size(), double(pl.a2), pl.g1 ? "true" : "false", tail_r, double(float(tail.share)),
                         l + 1 < plan.size() ? chain.size(int(l) + 1) : 0);
             // A level by spherical harmonics: ibl_prefilter_sh's texture (pairs x 3 texels, row by row).
             const int bands = ibl::detail::prefilter_sh_bands<ibl::ggx_lobe>(o, lp);

@@ -577,6 +577,10 @@ def compare_prefilter(fixtures, result):
                     print(f"  {name} value {i}: GLSL {g!r} C++ {e!r}")
                 bad += 1
         tail = f", coarse tail {lv['tail_share']:.4g} of the {lv['next_n']}^2 next level" if lv.get("tail_share", 0) > 0 else ""
+        if "mid" in lv:
+            m = lv["mid"]
+            tail = (f", coarse tail {lv['tail_share']:.4g} of an intermediate {m['n']}^2 level at r = {m['roughness']:.4g} "
+                    f"({m['count']} taps, its own tail {m['tail_share']:.4g} of the next level)")
         how = f"{lv['sh_bands']} SH bands" if lv.get("sh_bands", 0) > 0 else f"{lv['count']} taps"
         print(f"{name} ({lv['n']}^2 x 6, {how}, {lv['peak_count']} peaks{tail}): worst |diff| / (2^-11 |C++|) "
               f"{worst:.3g}, {bad} values outside")
@@ -596,11 +600,21 @@ def compare_prefilter(fixtures, result):
     print(f"viewer packing: max difference from ibl::detail::pack_cube {result['packed_max_rel']:.3g} of the larger "
           f"of the base's and the source's texel ({result['packed_max_rel_base']:.3g} of the base's)")
     ok = ok and result["packed_max_rel"] <= 1e-6
+    def taps_ok(d):
+        # the taps to float rounding, the factor and the coarse tail's share (0 without one)
+        return "max_abs" in d and d["max_abs"] <= 1e-5 and abs(d["factor"] - d["expected_factor"]) <= 1e-6 * abs(d["expected_factor"]) \
+            and abs(d.get("tail_share", -1) - d.get("expected_tail_share", 0)) <= 1e-6
     for lv, d in zip(fixtures["levels"], result["taps"]):
         print(f"viewer taps, level {lv['level']} ({lv['weight']}): {d}")
-        ok = ok and "max_abs" in d and d["max_abs"] <= 1e-5 and abs(d["factor"] - d["expected_factor"]) <= 1e-6 * abs(d["expected_factor"])
-        # the coarse tail's share of the next level (0 without one)
-        ok = ok and abs(d.get("tail_share", -1) - d.get("expected_tail_share", 0)) <= 1e-6
+        ok = ok and taps_ok(d) and (("mid" in lv) == ("mid" in d)) and ("mid" not in lv or taps_ok(d["mid"]))
+    # The intermediate coarse tail's rule (refilter.js midTail against prefilter_mid_roughness and
+    # the own and intermediate samples): the same levels, roughness and samples.
+    for lv, d in zip(fixtures["levels"], result["mid"]):
+        print(f"viewer intermediate level, level {lv['level']} ({lv['weight']}): {d}")
+        ok = ok and d["mid"] == d["expected_mid"]
+        if d["expected_mid"]:
+            ok = ok and d["roughness_abs"] <= 1e-12 and d["own"] == d["expected_own"] and d["samples"] == d["expected_samples"]
+    ok = ok and any("mid" in lv for lv in fixtures["levels"])  # the fixtures force one
     for lv, d in zip(fixtures["levels"], result["peaks"]):
         print(f"viewer peaks, level {lv['level']} ({lv['weight']}): {d} (C++ {lv['peak_count']} peaks)")
         ok = ok and d.get("count") == lv["peak_count"] and "dir_max_abs" in d and d["dir_max_abs"] <= 1e-6 and \
@@ -633,7 +647,7 @@ def compare_prefilter(fixtures, result):
     return ok
 
 
-def compare_refilter(result, rel=2e-3):
+def compare_refilter(result, intermediate=0, rel=2e-3):
     """The viewer's live re-filter (Renderer.refilter: refilter.js and ibl_prefilter.glsl on the
     chain's level 0) against the chain ibl-bake wrote (ibl::prefilter, the fast filter): every value
     within `rel` of the C++'s, relative to max(|C++|, 1e-3 of the level's mean). The differences
@@ -641,7 +655,11 @@ def compare_refilter(result, rel=2e-3):
     texel of a row by more than 1e-3 relative; the GPU adds every peak) and float rounding."""
     ok = bool(result["levels"])
     t = result["timing"]
-    print(f"re-filter: {t['levels']} levels, {t['peaks']} peaks: {t['gpu_ms']:.1f} ms GPU + {t['prepare_ms']:.1f} ms CPU")
+    print(f"re-filter: {t['levels']} levels ({t.get('intermediate', 0)} intermediate levels drawn too, the bake's report "
+          f"names {intermediate}), {t['peaks']} peaks: {t['gpu_ms']:.1f} ms GPU + {t['prepare_ms']:.1f} ms CPU")
+    # the viewer's rule (refilter.js midTail) finds the bake's intermediate levels (report.json's
+    # specular.mid_tail.mid_roughness_per_level)
+    ok = ok and t.get("intermediate", 0) == intermediate
     for lv in result["levels"]:
         cpp, gpu = lv["cpp"], lv["gpu"]
         mean = sum(abs(v) for v in cpp) / max(1, len(cpp))
@@ -895,7 +913,9 @@ def main():
         elif a.mode == "prefilter":
             ok = compare_prefilter(json.loads(prefilter_fixtures), result)
         elif a.mode == "refilter":
-            ok = compare_refilter(result)
+            report = json.load(open(os.path.join(bake_dir, "report.json")))
+            mids = (report["specular"].get("mid_tail") or {}).get("mid_roughness_per_level") or []
+            ok = compare_refilter(result, intermediate=sum(1 for r in mids if r is not None))
         elif a.mode == "room":
             ok = compare_room(json.loads(room_fixtures), result, ROOM_REL, ROOM_ABS)
         elif a.mode == "bc6h":

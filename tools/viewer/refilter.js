@@ -274,6 +274,31 @@ export function fastTaps(rows, roughness, samples, weight, trilinear, packed, ne
              factor: total > 0 ? Math.fround(scale / total) : 0, tail_share: Math.fround(rest.share), tail_c: rest.c };
 }
 
+/// prefilter_options::mid_tail's defaults (the C++ prefilter's; bake/prefilter_fast.hpp,
+/// "Intermediate coarse tail").
+export const midTailDefaults = { enabled: true, maxRoughness: 0.3, position: 0.1, own: 0.375, mid: 1.0, minTexels: 3.0, minOwnSamples: 16 };
+
+/// The intermediate coarse tail of a level (detail::prefilter_mid_roughness, prefilter_mid_own_samples,
+/// prefilter_mid_samples): a level at roughness r filtered with `samples` whose coarse tail would
+/// read the next level (roughness rn >= 0, face nextFace) reads it instead from an intermediate
+/// level at rm = r + position (rn - r) on a face of nextFace, filtered with `mid` samples and its
+/// own coarse tail from the next level, no peaks, and spends `own` samples on the rest of its
+/// kernel. Returns { roughness: rm, own, mid } or null where the level reads the next one directly.
+export function midTail(r, rn, samples, nextFace, opt = midTailDefaults) {
+    if (!opt.enabled || !(opt.position > 0) || !(opt.position < 1) || !(opt.own > 0) || !(opt.mid > 0)) return null;
+    if (!(rn >= 0)) return null;
+    r = Math.min(1, Math.max(0, Number.isFinite(r) ? r : 0));
+    if (!(r <= opt.maxRoughness) || !(rn > r)) return null;
+    const own = Math.max(1, Math.round(Math.min(1, opt.own) * samples));
+    if (own < opt.minOwnSamples) return null;
+    const rm = r + opt.position * (rn - r);
+    // the intermediate face resolves its kernel: a texel at the face centre is 2 / face radians
+    const face = Math.max(1, nextFace), minTexels = Number.isFinite(opt.minTexels) ? opt.minTexels : 3;
+    if (!(ggxLdFwhm(rm) >= minTexels * 2 / face)) return null;
+    const mid = Math.max(1, Math.round(Math.min(opt.mid * Math.max(samples, 1), 1 << 24)));
+    return { roughness: rm, own, mid };
+}
+
 // ---- the peak split (include/ibl/bake/prefilter_peaks.hpp) ----------------------------------------
 
 /// peak_split_options' defaults (the C++ prefilter's; its row cut has no GPU counterpart: the GPU

@@ -33,7 +33,7 @@
 // for Zstandard-supercompressed files (--ktx2-zstd N), the panel says so and nothing is drawn.
 
 import { parseKtx2Cubemap, meanLuminance, halfToFloat } from './ktx2.js';
-import { packSource, parseFastShapes, fastTaps, splitPeaks, makePeakLevel, shBands, shProject, shProjectionLevel, shLevel } from './refilter.js';
+import { packSource, parseFastShapes, fastTaps, midTail, midTailDefaults, splitPeaks, makePeakLevel, shBands, shProject, shProjectionLevel, shLevel } from './refilter.js';
 
 const params = new URLSearchParams(location.search);
 const testMode = params.get('test');
@@ -468,8 +468,10 @@ class Renderer {
     /// whose kernel needs at most 24 bands, its spherical-harmonic reconstruction from the source's
     /// projection, itself a GPU pass: sh_project.frag.glsl) and renders
     /// every face of every level into the chain texture, coarse to fine (a level's coarse tail reads
-    /// the next level back from the GPU and packs it). Returns { prepare_ms (split, packing, taps and peaks, CPU),
-    /// gpu_ms (the passes, to gl.finish), levels, peaks (level-0 peaks) }.
+    /// the next level back from the GPU and packs it, or the intermediate level the C++ filters for
+    /// it: refilter.js midTail, off where report.json's specular.mid_tail says the bake had it off).
+    /// Returns { prepare_ms (split, packing, taps and peaks, CPU), gpu_ms (the passes, to gl.finish),
+    /// levels, intermediate (intermediate levels drawn), peaks (level-0 peaks) }.
     refilter(prefilterFragment, shapesText, projectFragment) {
         const gl = this.gl, bake = this.bake, chain = bake.chain;
         const spec = bake.report && bake.report.specular;
@@ -490,6 +492,7 @@ class Renderer {
         const weight = spec.ld_weight === 'g1' ? 'g1' : 'nl';
         const plan = [];
         const convolved = (k) => k > 0 && k < chain.levels.length && spec.levels[k] && spec.levels[k].virtual_level > 0;
+        const midOn = !(spec.mid_tail && spec.mid_tail.enabled === false);
         // The rough levels by spherical harmonics (sh_rough_options' defaults): the bands each level
         // needs, and the split's base projected once onto the most of them.
         const bands = spec.levels.map((lv, k) => (convolved(k) ? shBands(lv.roughness, weight) : 0));
@@ -498,7 +501,7 @@ class Renderer {
             if (!convolved(k)) return;
             const peaks = makePeakLevel(split.peaks, n0, packed.levels.length, lv.roughness, weight);
             if (bands[k] > 0) { // no taps and no coarse tail
-                plan.push({ k, n: chain.levels[k].size, count: 0, taps: new Float32Array(0), info: new Float32Array(0), factor: 0,
+                plan.push({ k, key: `${k}`, order: k, n: chain.levels[k].size, count: 0, taps: new Float32Array(0), info: new Float32Array(0), factor: 0,
                             tail_share: 0, roughness: lv.roughness, sh_bands: bands[k], sh: null, ...peaks });
                 return;
             }
@@ -510,16 +513,25 @@ class Renderer {
             for (let v = 1; v < lv.virtual_level && samples < 16384; ++v) samples *= 4;
             if (fast) samples = lv.samples;
             const trilinear = fast ? lv.trilinear === true : false;
-            // The coarse tail (prefilter_options::coarse_tail): from the next level when its face is >= 16.
+            // The coarse tail (prefilter_options::coarse_tail): from the next level when its face is >= 16,
+            // or from an intermediate level (prefilter_options::mid_tail, refilter.js midTail: a
+            // 256^2 chain's level 1) rendered just before the level, on the next level's face, with
+            // its own tail from the next level and no peaks; off where the bake turned it off.
             const rn = convolved(k + 1) && chain.levels[k + 1].size >= 16 ? spec.levels[k + 1].roughness : -1;
-            plan.push({ k, n: chain.levels[k].size, ...fastTaps(shapes, lv.roughness, Math.min(samples, 16384), weight, trilinear, packed, rn),
-                        ...peaks });
+            const s = Math.min(samples, 16384);
+            const mt = midOn && rn >= 0 ? midTail(lv.roughness, rn, s, chain.levels[k + 1].size) : null;
+            const key = `${k}`, nextKey = mt ? `mid${k}` : `${k + 1}`;
+            if (mt)
+                plan.push({ k, key: nextKey, order: k + 0.5, nextKey: `${k + 1}`, isMid: true, n: chain.levels[k + 1].size,
+                            ...fastTaps(shapes, mt.roughness, mt.mid, weight, trilinear, packed, rn), peak_count: 0 });
+            plan.push({ k, key, order: k, nextKey, n: chain.levels[k].size,
+                        ...fastTaps(shapes, lv.roughness, mt ? mt.own : s, weight, trilinear, packed, mt ? mt.roughness : rn), ...peaks });
         });
-        plan.sort((a, b) => b.k - a.k); // coarse to fine: a coarse tail reads the finished next level
-        const done = new Map(); // level k -> its faces before their peaks (RGBA floats), for the level before it
+        plan.sort((a, b) => b.order - a.order); // coarse to fine: a coarse tail reads the finished next level
+        const done = new Map(); // level key -> { n, faces before their peaks (RGBA floats) }, for the level that reads it
         for (const lv of plan)
             lv.next = () => {
-                const m = chain.levels[lv.k + 1].size, faces = done.get(lv.k + 1);
+                const { n: m, faces } = done.get(lv.nextKey);
                 return { n: m, data: packSource(m, (f, x, y) => { const i = 4 * (y * m + x); return [faces[f][i], faces[f][i + 1], faces[f][i + 2]]; }, null, 1).data };
             };
         const t1 = performance.now();
@@ -530,10 +542,12 @@ class Renderer {
         }
         const fb = gl.createFramebuffer();
         gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-        const needed = (lv) => plan.some((p) => p.k === lv.k - 1 && p.tail_share > 0);
+        // An intermediate level draws only its second output (it has no peaks: both are the same).
+        const needed = (lv) => lv.isMid || plan.some((p) => p.tail_share > 0 && p.nextKey === lv.key);
         let beforeTex = null; // the second output (the texels before their peaks) of a level that is read back
         const made = prefilterPasses(gl, this.prefilterProgram, this.vao, plan, (lv, f) => {
-            gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k);
+            if (lv.isMid) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, null, 0);
+            else gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_CUBE_MAP_POSITIVE_X + f, this.chainTex, lv.k);
             if (f === 0 && needed(lv)) {
                 gl.activeTexture(gl.TEXTURE5); // on no sampler's unit
                 if (beforeTex) gl.deleteTexture(beforeTex);
@@ -547,15 +561,16 @@ class Renderer {
             if (f === 0 && !needed(lv)) gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT1, gl.TEXTURE_2D, null, 0);
             const status = gl.checkFramebufferStatus(gl.FRAMEBUFFER);
             if (status !== gl.FRAMEBUFFER_COMPLETE) throw new Error(`re-filter: level ${lv.k} face ${f}: framebuffer incomplete (0x${status.toString(16)})`);
-            gl.drawBuffers(needed(lv) ? [gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1] : [gl.COLOR_ATTACHMENT0, gl.NONE]);
+            gl.drawBuffers(lv.isMid ? [gl.NONE, gl.COLOR_ATTACHMENT1]
+                                    : needed(lv) ? [gl.COLOR_ATTACHMENT0, gl.COLOR_ATTACHMENT1] : [gl.COLOR_ATTACHMENT0, gl.NONE]);
         }, (lv, f) => {
             if (!needed(lv)) return;
             const px = new Float32Array(4 * lv.n * lv.n);
             gl.readBuffer(gl.COLOR_ATTACHMENT1);
             gl.readPixels(0, 0, lv.n, lv.n, gl.RGBA, gl.FLOAT, px);
             gl.readBuffer(gl.COLOR_ATTACHMENT0);
-            if (!done.has(lv.k)) done.set(lv.k, []);
-            done.get(lv.k)[f] = px;
+            if (!done.has(lv.key)) done.set(lv.key, { n: lv.n, faces: [] });
+            done.get(lv.key).faces[f] = px;
         });
         if (beforeTex) gl.deleteTexture(beforeTex);
         gl.finish();
@@ -563,7 +578,8 @@ class Renderer {
         gl.bindFramebuffer(gl.FRAMEBUFFER, null);
         gl.deleteFramebuffer(fb);
         for (const t of made.concat([srcTex])) gl.deleteTexture(t);
-        return { prepare_ms: t1 - t0, gpu_ms: t2 - t1, levels: plan.length, peaks: split.peaks.length };
+        return { prepare_ms: t1 - t0, gpu_ms: t2 - t1, levels: plan.filter((p) => !p.isMid).length,
+                 intermediate: plan.filter((p) => p.isMid).length, peaks: split.peaks.length };
     }
 
     /// Draws into the canvas at its current size. view: { mode, roughness, ev, lookup, multiscatter,
@@ -819,16 +835,35 @@ async function runPrefilterTest() {
         packedDiffBase = Math.max(packedDiffBase, d / Math.max(1e-30, Math.abs(fx.packed[k])));
     }
     const shapes = parseFastShapes(await fetchText(glslBase + '../bake/prefilter_fast_tables.hpp'));
-    // A level with a coarse tail (tail_share > 0) has its next level's roughness in the fixtures.
-    const nextR = (lv) => (lv.tail_share > 0 ? lv.next_roughness : -1);
-    const jsTaps = fx.levels.map((lv) => fastTaps(shapes, lv.roughness, lv.samples, lv.weight, lv.trilinear, js, nextR(lv)));
-    const tapsDiff = fx.levels.map((lv, i) => {
-        const t = jsTaps[i];
-        if (t.count !== lv.count) return { count: t.count, expected: lv.count };
+    // A level with a coarse tail (tail_share > 0) has the roughness its tail reads in the fixtures:
+    // the next level's, or with an intermediate level (lv.mid, whose own tail reads the next level)
+    // the intermediate one's. The viewer's rule (refilter.js midTail, with the fixtures' forced
+    // min_texels = 0) must find the same intermediate level, own samples and intermediate samples.
+    const nextR = (lv) => (lv.mid ? lv.mid.next_roughness : lv.tail_share > 0 ? lv.next_roughness : -1);
+    const jsMid = fx.levels.map((lv) => midTail(lv.roughness, nextR(lv), lv.plan_samples, lv.mid ? lv.mid.n : lv.next_n,
+                                                 { ...midTailDefaults, minTexels: 0 }));
+    const midDiff = fx.levels.map((lv, i) => {
+        const m = jsMid[i];
+        if (!m || !lv.mid) return { mid: !!m, expected_mid: !!lv.mid };
+        return { mid: true, expected_mid: true, roughness_abs: Math.abs(m.roughness - lv.mid.roughness), own: m.own,
+                 expected_own: lv.samples, samples: m.mid, expected_samples: lv.mid.samples };
+    });
+    const jsTaps = fx.levels.map((lv, i) => {
+        const m = jsMid[i];
+        const t = fastTaps(shapes, lv.roughness, m ? m.own : lv.plan_samples, lv.weight, lv.trilinear, js, m ? m.roughness : nextR(lv));
+        if (m) t.mid = { n: lv.mid ? lv.mid.n : lv.next_n, ...fastTaps(shapes, m.roughness, m.mid, lv.weight, lv.trilinear, js, nextR(lv)) };
+        return t;
+    });
+    const tapDiff = (t, e) => {
+        if (t.count !== e.count) return { count: t.count, expected: e.count };
         let d = 0;
-        for (let k = 0; k < 4 * lv.count; ++k) d = Math.max(d, Math.abs(t.taps[k] - lv.taps[k]), Math.abs(t.info[k] - lv.info[k]));
-        return { max_abs: d, factor: t.factor, expected_factor: lv.factor, tail_share: t.tail_share,
-                 expected_tail_share: lv.tail_share || 0 };
+        for (let k = 0; k < 4 * e.count; ++k) d = Math.max(d, Math.abs(t.taps[k] - e.taps[k]), Math.abs(t.info[k] - e.info[k]));
+        return { max_abs: d, factor: t.factor, expected_factor: e.factor, tail_share: t.tail_share, expected_tail_share: e.tail_share || 0 };
+    };
+    const tapsDiff = fx.levels.map((lv, i) => {
+        const d = tapDiff(jsTaps[i], lv);
+        if (lv.mid) d.mid = jsTaps[i].mid ? tapDiff(jsTaps[i].mid, lv.mid) : { count: 0, expected: lv.mid.count };
+        return d;
     });
     const jsPeaks = fx.levels.map((lv) => makePeakLevel(split.peaks, n0, js.levels.length, lv.roughness, lv.weight));
     // The levels by spherical harmonics: the band choice, the projection of the viewer's packing
@@ -875,12 +910,27 @@ async function runPrefilterTest() {
     // Each level into two RGBA32F targets (the texels, and the texels before their peaks), read back
     // face by face (rows from y = 0: the chain's order). The levels go coarse to fine per weight, and
     // a coarse tail reads the GPU's own next level before its peaks (read back, packed by packSource).
+    // A level with an intermediate level (lv.mid: n, taps, its tail's share) has it rendered as one
+    // more level just before it (no peaks, its tail from the next level, not posted), and reads its
+    // own coarse tail from it.
     const render = (levels) => {
         const out = [], before = new Map();
-        const ordered = levels.slice().sort((a, b) => (a.weight === b.weight ? b.level - a.level : a.weight < b.weight ? -1 : 1));
+        const all = [];
+        for (const lv of levels) {
+            lv.key = `${lv.weight}/${lv.level}`;
+            lv.order = lv.level;
+            lv.nextKey = `${lv.weight}/${lv.level + 1}`;
+            if (lv.mid) {
+                all.push({ ...lv.mid, level: lv.level, weight: lv.weight, peak_count: 0, sh_bands: 0, isMid: true,
+                           key: `${lv.weight}/mid${lv.level}`, order: lv.level + 0.5, nextKey: lv.nextKey });
+                lv.nextKey = `${lv.weight}/mid${lv.level}`;
+            }
+            all.push(lv);
+        }
+        const ordered = all.sort((a, b) => (a.weight === b.weight ? b.order - a.order : a.weight < b.weight ? -1 : 1));
         for (const lv of ordered)
             lv.next = () => {
-                const nx = before.get(`${lv.weight}/${lv.level + 1}`);
+                const nx = before.get(lv.nextKey);
                 const m = nx.n, at = (f, x, y) => { const k = 3 * ((f * m + y) * m + x); return [nx.rgb[k], nx.rgb[k + 1], nx.rgb[k + 2]]; };
                 return { n: m, data: packSource(m, at, null, 1).data };
             };
@@ -911,8 +961,8 @@ async function runPrefilterTest() {
             readBack(lv.n, gl.COLOR_ATTACHMENT0, rgb);
             readBack(lv.n, gl.COLOR_ATTACHMENT1, base);
             if (f === 5) {
-                out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
-                before.set(`${lv.weight}/${lv.level}`, { n: lv.n, rgb: base });
+                if (!lv.isMid) out.push({ level: lv.level, weight: lv.weight, n: lv.n, rgb });
+                before.set(lv.key, { n: lv.n, rgb: base });
             }
         });
         gl.readBuffer(gl.COLOR_ATTACHMENT0);
@@ -925,7 +975,7 @@ async function runPrefilterTest() {
     const jsLevels = render(fx.levels.map((lv, i) => ({ level: lv.level, weight: lv.weight, n: lv.n, ...jsTaps[i], ...jsPeaks[i],
                                                         ...jsSh[i] })));
     await post({ kind: 'prefilter', levels, js_levels: jsLevels, packed_max_rel: packedDiff,
-                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, peaks: peaksDiff, sh: shDiff, sh_gpu: shGpuDiff,
+                 packed_max_rel_base: packedDiffBase, taps: tapsDiff, mid: midDiff, peaks: peaksDiff, sh: shDiff, sh_gpu: shGpuDiff,
                  source_peaks: split.peaks.length, threshold: split.threshold, renderer: rendererName(gl) });
 }
 
