@@ -15,6 +15,7 @@
 #if IBL_DETAIL_CXX20
 
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <exception>
@@ -38,6 +39,9 @@ namespace detail {
 /// read). One pool per worker count, created on first use and never destroyed (its threads wait
 /// on a condition variable until the process exits; no destruction order at exit to get wrong);
 /// a child of fork() starts its own.
+/// A worker spins for up to spin_time after a call before it blocks, and the caller spins while
+/// the workers finish: calls that follow each other closely (a prefilter's levels) pass no
+/// wake-up through the kernel (docs/ARCHITECTURE.md, "Determinism and executors").
 /// One call at a time: a call made while the pool is busy (from another thread, or from inside a
 /// job) runs on its own threads, as before the pool. An exception thrown by a chunk, on any
 /// thread, stops the call's remaining chunks and is rethrown to the caller once the workers are
@@ -85,10 +89,14 @@ public:
             std::lock_guard<std::mutex> lock(m_);
             error_ = nullptr; // before the workers see the job
             active_ = threads_.size();
+            busy_workers_.store(active_, std::memory_order_relaxed);
             ++generation_;
+            seen_generation_.store(generation_, std::memory_order_release);
         }
         start_.notify_all();
         take_chunks();
+        // The workers finish their last chunks about now: wait for them awake a little first.
+        spin_until([this] { return busy_workers_.load(std::memory_order_acquire) == 0; });
         std::unique_lock<std::mutex> lock(m_);
         done_.wait(lock, [this] { return active_ == 0; }); // the workers read the job until then
         job_ = nullptr;
@@ -118,9 +126,25 @@ private:
         }
         in_job_flag() = false;
     }
+    /// Spins (a pause a turn) until done() or spin_time has passed; true when done() became true.
+    template <class Done> static bool spin_until(Done&& done) noexcept {
+        const auto until = std::chrono::steady_clock::now() + spin_time;
+        for (unsigned k = 0;; ++k) {
+            if (done()) return true;
+#if defined(__x86_64__) || defined(__i386__)
+            __builtin_ia32_pause();
+#else
+            std::this_thread::yield();
+#endif
+            if ((k & 63u) == 63u && std::chrono::steady_clock::now() >= until) return false;
+        }
+    }
     void work() {
         std::size_t seen = 0;
         for (;;) {
+            // A call that follows the last one closely (a prefilter's levels) finds this worker
+            // awake: no wake-up through the kernel.
+            spin_until([&] { return seen_generation_.load(std::memory_order_acquire) != seen; });
             {
                 std::unique_lock<std::mutex> lock(m_);
                 start_.wait(lock, [&] { return generation_ != seen; });
@@ -128,9 +152,11 @@ private:
             }
             take_chunks();
             std::lock_guard<std::mutex> lock(m_);
+            busy_workers_.store(active_ - 1, std::memory_order_release);
             if (--active_ == 0) done_.notify_one();
         }
     }
+    static constexpr std::chrono::microseconds spin_time{300};
 
     std::vector<std::thread> threads_;
     std::mutex busy_; ///< held by the call in progress
@@ -141,6 +167,7 @@ private:
     void* job_ = nullptr;
     std::size_t count_ = 0, chunk_ = 1;
     std::atomic<std::size_t> next_{0};
+    std::atomic<std::size_t> seen_generation_{0}, busy_workers_{0}; ///< generation_ and active_, for the spins
     std::exception_ptr error_; ///< guarded by m_
 };
 
