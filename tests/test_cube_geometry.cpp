@@ -6,6 +6,7 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <vector>
 
 namespace {
 using d3 = ibl::vec3<double>;
@@ -62,6 +63,19 @@ TEST_CASE("edge and corner directions get exactly one face; degenerate input is 
     // Coordinates on an edge are exactly 0 or 1.
     const auto e = ibl::cube_lookup(d3(1, 1, 0.25));
     CHECK(e.t == 0.0); // +X face: tc = -ry / |rx| = -1 -> t = 0
+}
+
+TEST_CASE_TEMPLATE("cube_face_solid_angles is cube_texel_solid_angle at every texel, from the corners", T, float, double) {
+    for (int n : {1, 2, 3, 7, 64, 257}) {
+        const std::vector<T> table = ibl::cube_face_solid_angles<T>(n);
+        REQUIRE(table.size() == std::size_t(n) * std::size_t(n));
+        int differ = 0;
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                differ += table[std::size_t(y) * std::size_t(n) + std::size_t(x)] == ibl::cube_texel_solid_angle<T>(x, y, n) ? 0 : 1;
+        CHECK(differ == 0); // the same four antiderivative values in the same order: the same bits
+    }
+    CHECK(ibl::cube_face_solid_angles<double>(0).empty());
 }
 
 TEST_CASE("texel solid angles are exact: sum 4 pi, match the face integral, symmetric") {

@@ -213,9 +213,7 @@ template <class T> irradiance_texel_moments make_irradiance_texel_moments(const 
     const std::size_t blocks = std::size_t(6) * std::size_t(m) * std::size_t(m);
     std::vector<vec3<double>> pw(blocks, vec3<double>(0.0)), yd(blocks, vec3<double>(0.0)), gd(blocks, vec3<double>(0.0));
     std::vector<double> ysum(blocks, 0.0), gsum(blocks, 0.0);
-    std::vector<double> omega(std::size_t(n) * std::size_t(n));
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+    const std::vector<double> omega = cube_face_solid_angles<double>(n);
     for (int f = 0; f < 6; ++f)
         for (int y = 0; y < n; ++y) {
             const int by = int((long long)y * m / n);

@@ -144,33 +144,10 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
     if (!opt.enabled) return s;
     const int n = src.size(0);
     const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
-    std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
-    ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-        for (std::size_t row = b; row < e; ++row) {
-            const int f = int(row) / n, y = int(row) % n;
-            for (int x = 0; x < n; ++x) {
-                const float l = float(luminance(src.texel(f, x, y, 0)));
-                lum[cube_texel_index(f, x, y, n)] = std::isfinite(l) && l > 0.f ? l : 0.f;
-            }
-        }
-    });
-    // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
-    // so a chain down to 1 x 1 gives it in six reads; otherwise level 0 by texel solid angles.
-    double acc = 0.0;
-    const int top = src.levels() - 1;
-    if (src.size(top) == 1) {
-        for (int f = 0; f < 6; ++f) {
-            const double l = double(luminance(src.texel(f, 0, 0, top)));
-            acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
-        }
-        s.mean_luminance = acc / 6.0;
-    } else {
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x) acc += double(lum[cube_texel_index(f, x, y, n)]) * cube_texel_solid_angle<double>(x, y, n);
-        s.mean_luminance = acc / four_pi_v<double>;
-    }
-    double t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * s.mean_luminance : 0.0;
+    auto lum_of = [&](int f, int x, int y) {
+        const float l = float(luminance(src.texel(f, x, y, 0)));
+        return std::isfinite(l) && l > 0.f ? l : 0.f;
+    };
     // double(l) > t for a float l (>= 0, finite) is l >= above_t, the least float above t, so the
     // scans compare floats (they vectorise).
     auto least_float_above = [](double v) {
@@ -179,46 +156,99 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
         while (!(double(f) > v)) f = std::nextafter(f, std::numeric_limits<float>::infinity());
         return f;
     };
-    float above_t = least_float_above(t);
-    // The texels above t, in cube_texel_index order (face, row, column); blocks with no texel above
-    // are skipped at once (the count vectorises).
-    std::vector<std::size_t> hits;
-    for (std::size_t b = 0; b < count; b += 64) {
-        const std::size_t e = std::min(count, b + 64);
-        int in_block = 0;
-        for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
-        if (in_block > 0)
-            for (std::size_t i = b; i < e; ++i)
-                if (lum[i] >= above_t) hits.push_back(i);
+    // The texels above t (cube_texel_index, luminance), in cube_texel_index order (face, row, column).
+    std::vector<std::pair<std::size_t, float>> hits;
+    double t = 0.0;
+    float above_t = 0.f;
+    const auto threshold_of = [&](double mean) {
+        s.mean_luminance = mean;
+        t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * mean : 0.0;
+        above_t = least_float_above(t);
+    };
+    const int top = src.levels() - 1;
+    if (src.size(top) == 1) {
+        // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
+        // so a chain down to 1 x 1 gives it in six reads, and one pass over level 0 finds the
+        // texels above t, each row its own (rows without any skipped at once: the count vectorises).
+        double acc = 0.0;
+        for (int f = 0; f < 6; ++f) {
+            const double l = double(luminance(src.texel(f, 0, 0, top)));
+            acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
+        }
+        threshold_of(acc / 6.0);
+        std::vector<std::vector<std::pair<std::size_t, float>>> row_hits(std::size_t(6 * n));
+        ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+            std::vector<float> row(static_cast<std::size_t>(n));
+            for (std::size_t r = b; r < e; ++r) {
+                const int f = int(r) / n, y = int(r) % n;
+                for (int x = 0; x < n; ++x) row[std::size_t(x)] = lum_of(f, x, y);
+                int in_row = 0;
+                for (int x = 0; x < n; ++x) in_row += row[std::size_t(x)] >= above_t ? 1 : 0;
+                if (in_row == 0) continue;
+                row_hits[r].reserve(std::size_t(in_row));
+                for (int x = 0; x < n; ++x)
+                    if (row[std::size_t(x)] >= above_t) row_hits[r].emplace_back(cube_texel_index(f, x, y, n), row[std::size_t(x)]);
+            }
+        });
+        for (const auto& rh : row_hits) hits.insert(hits.end(), rh.begin(), rh.end());
+    } else {
+        // Otherwise the mean of level 0 by texel solid angles, then the scan.
+        std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
+        ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+            for (std::size_t row = b; row < e; ++row) {
+                const int f = int(row) / n, y = int(row) % n;
+                for (int x = 0; x < n; ++x) lum[cube_texel_index(f, x, y, n)] = lum_of(f, x, y);
+            }
+        });
+        const std::vector<double> omega = cube_face_solid_angles<double>(n);
+        double acc = 0.0;
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x)
+                    acc += double(lum[cube_texel_index(f, x, y, n)]) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+        threshold_of(acc / four_pi_v<double>);
+        for (std::size_t b = 0; b < count; b += 64) {
+            const std::size_t e = std::min(count, b + 64);
+            int in_block = 0;
+            for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
+            if (in_block > 0)
+                for (std::size_t i = b; i < e; ++i)
+                    if (lum[i] >= above_t) hits.emplace_back(i, lum[i]);
+        }
     }
     if (hits.size() > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
         // The (max_peaks + 1)-th brightest texel is among these texels above t: the selection
         // runs over those only (a few thousand, not the whole level), and the texels above the
         // new threshold are among them, in the same order.
         std::vector<float> sorted(hits.size());
-        for (std::size_t i = 0; i < hits.size(); ++i) sorted[i] = lum[hits[i]];
+        for (std::size_t i = 0; i < hits.size(); ++i) sorted[i] = hits[i].second;
         const std::size_t k = hits.size() - 1 - std::size_t(opt.max_peaks);
         std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
         t = std::max(t, double(sorted[k]));
         above_t = least_float_above(t);
-        std::erase_if(hits, [&](std::size_t i) { return !(lum[i] >= above_t); });
+        std::erase_if(hits, [&](const std::pair<std::size_t, float>& h) { return !(h.second >= above_t); });
     }
     s.threshold = t;
     if (!(t > 0.0)) return s;
+    // The peaks through the executor (each one its own: the exact solid angle's four atan2 make
+    // this the split's dearest serial part otherwise).
     const std::size_t nn = std::size_t(n) * std::size_t(n);
-    for (const std::size_t i : hits) {
-        const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
-        const float l = lum[i];
-        const vec3<double> v(src.texel(f, x, y, 0));
-        const double om = cube_texel_solid_angle<double>(x, y, n);
-        cube_peak p;
-        p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
-        p.energy = v * ((1.0 - t / double(l)) * om);
-        p.weight = (double(l) - t) * om;
-        p.luminance = l;
-        p.face = f, p.x = x, p.y = y;
-        s.peaks.push_back(p);
-    }
+    s.peaks.resize(hits.size());
+    ex(hits.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t h = b; h < e; ++h) {
+            const std::size_t i = hits[h].first;
+            const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
+            const float l = hits[h].second;
+            const vec3<double> v(src.texel(f, x, y, 0));
+            const double om = cube_texel_solid_angle<double>(x, y, n);
+            cube_peak& p = s.peaks[h];
+            p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
+            p.energy = v * ((1.0 - t / double(l)) * om);
+            p.weight = (double(l) - t) * om;
+            p.luminance = l;
+            p.face = f, p.x = x, p.y = y;
+        }
+    });
     return s;
 }
 } // namespace detail

@@ -246,10 +246,8 @@ public:
     sh_projection() = default;
     sh_projection(int bands, int level, int face_size) : rec_(bands), level_(level), n_(face_size) {
         sums_.assign(std::size_t(6) * sh_pair_count(bands) * 6 * lanes, 0.f);
-        solid_.resize(std::size_t(face_size) * std::size_t(face_size));
-        for (int y = 0; y < face_size; ++y)
-            for (int x = 0; x < face_size; ++x)
-                solid_[std::size_t(y * face_size + x)] = float(cube_texel_solid_angle<double>(x, y, face_size));
+        const std::vector<double> solid = cube_face_solid_angles<double>(face_size);
+        solid_.assign(solid.begin(), solid.end()); // float of each
     }
     [[nodiscard]] int bands() const noexcept { return rec_.bands; }
     [[nodiscard]] int level() const noexcept { return level_; }

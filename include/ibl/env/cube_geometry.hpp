@@ -30,6 +30,7 @@
 
 #include <cmath>
 #include <cstddef>
+#include <vector>
 
 #include "../core/constants.hpp"
 #include "../core/vec.hpp"
@@ -150,6 +151,24 @@ template <class T> IBL_FUNC T cube_texel_solid_angle(int x, int y, int n) noexce
     const T inv = T(2) / T(n);
     return cube_rect_solid_angle(T(x) * inv - T(1), T(y) * inv - T(1), T(x + 1) * inv - T(1),
                                  T(y + 1) * inv - T(1));
+}
+
+/// The exact solid angles of an n x n face's texels, row by row (y n + x; the same on every
+/// face): each is cube_texel_solid_angle<T>(x, y, n) bit for bit (the same four antiderivative
+/// values, subtracted in the same order), from the (n + 1)^2 corner values instead of four per
+/// texel. Host only.
+template <class T> std::vector<T> cube_face_solid_angles(int n) {
+    const std::size_t m = std::size_t(n > 0 ? n : 0), c = m + 1;
+    const T inv = T(2) / T(n);
+    std::vector<T> corner(c * c);
+    for (std::size_t j = 0; j < c; ++j)
+        for (std::size_t i = 0; i < c; ++i)
+            corner[j * c + i] = detail::cube_area_antiderivative(T(int(i)) * inv - T(1), T(int(j)) * inv - T(1));
+    std::vector<T> out(m * m);
+    for (std::size_t y = 0; y < m; ++y)
+        for (std::size_t x = 0; x < m; ++x)
+            out[y * m + x] = corner[(y + 1) * c + x + 1] - corner[(y + 1) * c + x] - corner[y * c + x + 1] + corner[y * c + x];
+    return out;
 }
 
 } // namespace ibl

@@ -136,9 +136,7 @@ template <class T> struct sun_grid {
     std::vector<double> omega, Y;
 
     explicit sun_grid(const cubemap<T>& c)
-        : cube(c), n(c.size(0)), nn(std::size_t(n) * std::size_t(n)), count(6 * nn), omega(nn), Y(count) {
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+        : cube(c), n(c.size(0)), nn(std::size_t(n) * std::size_t(n)), count(6 * nn), omega(cube_face_solid_angles<double>(n)), Y(count) {
         for (std::size_t i = 0; i < count; ++i) Y[i] = sun_luminance(finite(i));
     }
     void coords(std::size_t i, int& f, int& x, int& y) const {

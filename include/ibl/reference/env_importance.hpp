@@ -94,9 +94,8 @@ public:
                             limits::max_distribution_size, "limits::max_distribution_size");
         n_ = cube.size(opt.level);
         const std::size_t n = std::size_t(n_), rows = 6 * n;
-        std::vector<double> omega(n * n), w(rows * n);
-        for (std::size_t y = 0; y < n; ++y)
-            for (std::size_t x = 0; x < n; ++x) omega[y * n + x] = cube_texel_solid_angle<double>(int(x), int(y), n_);
+        const std::vector<double> omega = cube_face_solid_angles<double>(n_);
+        std::vector<double> w(rows * n);
         double total = 0.0;
         for (int f = 0; f < 6; ++f)
             for (int y = 0; y < n_; ++y)

@@ -296,9 +296,7 @@ std::vector<vec3<double>> irradiance_texel_sum(const cubemap<T>& c, int level, s
                                     "), got " + std::to_string(level));
     const int n = c.size(level);
     const std::size_t nn = std::size_t(n) * std::size_t(n);
-    std::vector<double> omega(nn); // the same on every face
-    for (int y = 0; y < n; ++y)
-        for (int x = 0; x < n; ++x) omega[std::size_t(y) * std::size_t(n) + std::size_t(x)] = cube_texel_solid_angle<double>(x, y, n);
+    const std::vector<double> omega = cube_face_solid_angles<double>(n); // the same on every face
     std::vector<vec3<double>> dir, rad;
     dir.reserve(6 * nn);
     rad.reserve(6 * nn);
