@@ -838,15 +838,18 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 const detail::prefilter_cube_level lv = cs.level(env, rm >= 0.0 ? cs.mid_owner(lp) : lp, rm >= 0.0 ? rm : rn, n, ex);
                 // The level before this one reads its coarse tail from this level without its peaks
                 // (they are added to every level exactly, through its own kernel).
-                std::vector<vec3<float>> base;
+                // Those rows go straight into the bordered cube that level reads.
+                std::optional<cubemap<float>> tail;
                 if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0)
-                    base.resize(std::size_t(6) * std::size_t(n) * std::size_t(n));
+                    tail.emplace(n, 1, detail::for_overwrite);
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
                     for (std::size_t row = b; row < e; ++row)
-                        cs.row(lv, row, n, rows[row], nx, base.empty() ? nullptr : base.data() + row * std::size_t(n));
+                        cs.row(lv, row, n, rows[row], nx, tail ? &tail->texel_ref(int(row) / n, 0, int(row) % n, 0) : nullptr);
                 });
-                if (!base.empty())
-                    next = detail::prefilter_tail_cube(n, [&](int f, int x, int y) { return base[cube_texel_index(f, x, y, n)]; });
+                if (tail) {
+                    tail->update_borders();
+                    next = std::move(tail);
+                }
             }
         }
     } else {
