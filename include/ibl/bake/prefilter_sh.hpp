@@ -380,42 +380,64 @@ struct sh_level {
     }
 };
 
+/// Sixteen float lanes in one register where the target has AVX-512 (GCC and Clang's vector
+/// extension): the reconstruction's sixteen texels as one chunk instead of two of sh_f8, the same
+/// operations per lane (the same bits), about 8 % of a 256^2 fast chain (docs/ARCHITECTURE.md,
+/// "Compiler flags for speed").
+#if defined(__GNUC__) && defined(__AVX512F__)
+#define IBL_DETAIL_SH_F16 1
+using sh_f16 = float __attribute__((vector_size(64)));
+inline float sh_lane_of(const sh_f16& v, std::size_t k) noexcept { return v[k]; }
+#endif
+inline float sh_lane_of(const sh_f8& v, std::size_t k) noexcept { return sh_lane(v, k); }
+template <class V> inline V sh_splat_as(float s) noexcept {
+    if constexpr (std::is_same_v<V, sh_f8>) return sh_splat(s);
+    else return V{} + s;
+}
+template <class V> inline V sh_load_as(const float* p) noexcept {
+    V v;
+    __builtin_memcpy(&v, p, sizeof v);
+    return v;
+}
+
 /// Texels [x, x + 16) of row y of face `face` of an n x n level from its coefficients (header
-/// comment, "Basis"): two chunks of eight lanes side by side (two independent recurrences hide
-/// each other's latency), per m the cosine and sine sums over l in registers, then times Re / Im
-/// (x + i y)^m. Lanes past the row's end are computed on its last texel and not written.
-inline void sh_level_lanes16(const sh_level& lv, int face, int x, int y, int n, vec3<float>* out, const float* norm) noexcept {
-    constexpr std::size_t C = 2;
-    sh_f8 dx[C], dy[C], dz[C];
+/// comment, "Basis"): sixteen lanes, in chunks of L (16 with AVX-512; else two chunks of eight side
+/// by side, whose two independent recurrences hide each other's latency), per m the cosine and sine
+/// sums over l in registers, then times Re / Im (x + i y)^m. Lanes past the row's end are computed
+/// on its last texel and not written.
+template <class V, std::size_t L>
+inline void sh_level_lanes(const sh_level& lv, int face, int x, int y, int n, vec3<float>* out, const float* norm) noexcept {
+    constexpr std::size_t C = 16 / L; // chunks of L lanes
+    V dx[C], dy[C], dz[C];
     for (std::size_t c = 0; c < C; ++c) {
-        float fx[8], fy[8], fz[8];
-        sh_row_directions<8>(face, x + int(8 * c), y, n, fx, fy, fz);
-        dx[c] = sh_load(fx), dy[c] = sh_load(fy), dz[c] = sh_load(fz);
+        float fx[L], fy[L], fz[L];
+        sh_row_directions<L>(face, x + int(L * c), y, n, fx, fy, fz);
+        dx[c] = sh_load_as<V>(fx), dy[c] = sh_load_as<V>(fy), dz[c] = sh_load_as<V>(fz);
     }
     const sh_recurrence& rec = lv.rec;
     const int B = rec.bands;
     const float* cf = lv.coef.data();
-    sh_f8 r[C], g[C], b[C], cr[C], ci[C], qmm[C];
+    V r[C], g[C], b[C], cr[C], ci[C], qmm[C];
     for (std::size_t c = 0; c < C; ++c)
-        r[c] = g[c] = b[c] = ci[c] = sh_splat(0.f), cr[c] = sh_splat(1.f), qmm[c] = sh_splat(0.28209479177387814f);
+        r[c] = g[c] = b[c] = ci[c] = sh_splat_as<V>(0.f), cr[c] = sh_splat_as<V>(1.f), qmm[c] = sh_splat_as<V>(0.28209479177387814f);
     for (int m = 0; m < B; ++m) {
-        sh_f8 s0[C], s1[C], s2[C], s3[C], s4[C], s5[C], q1[C], q2[C];
+        V s0[C], s1[C], s2[C], s3[C], s4[C], s5[C], q1[C], q2[C];
         const float f = rec.mm[std::size_t(m)];
         for (std::size_t c = 0; c < C; ++c) {
             if (m > 0) {
-                const sh_f8 nr = cr[c] * dx[c] - ci[c] * dy[c], ni = cr[c] * dy[c] + ci[c] * dx[c];
+                const V nr = cr[c] * dx[c] - ci[c] * dy[c], ni = cr[c] * dy[c] + ci[c] * dx[c];
                 cr[c] = nr, ci[c] = ni, qmm[c] *= f;
             }
-            const sh_f8 q = qmm[c];
+            const V q = qmm[c];
             s0[c] = cf[0] * q, s1[c] = cf[1] * q, s2[c] = cf[2] * q, s3[c] = cf[3] * q, s4[c] = cf[4] * q, s5[c] = cf[5] * q;
-            q1[c] = q, q2[c] = sh_splat(0.f);
+            q1[c] = q, q2[c] = sh_splat_as<V>(0.f);
         }
         cf += 6;
         for (int l = m + 1; l < B; ++l, cf += 6) { // a_(m+1)m = sqrt(2m + 3), b = 0 starts the recurrence
             const float a = rec.a[std::size_t(l * B + m)], bb = rec.b[std::size_t(l * B + m)];
             const float c0 = cf[0], c1 = cf[1], c2 = cf[2], c3 = cf[3], c4 = cf[4], c5 = cf[5];
             for (std::size_t c = 0; c < C; ++c) {
-                const sh_f8 q = a * (dz[c] * q1[c] - bb * q2[c]);
+                const V q = a * (dz[c] * q1[c] - bb * q2[c]);
                 q2[c] = q1[c], q1[c] = q;
                 s0[c] += c0 * q, s1[c] += c1 * q, s2[c] += c2 * q, s3[c] += c3 * q, s4[c] += c4 * q, s5[c] += c5 * q;
             }
@@ -428,12 +450,19 @@ inline void sh_level_lanes16(const sh_level& lv, int face, int x, int y, int n, 
     }
     // Radiance is not negative: the truncation's ringing around a light above the split's threshold
     // (or any light, without the split) is clamped at 0. norm (the row's): divided by it.
-    for (std::size_t k = 0; k < 8 * C && x + int(k) < n; ++k) {
-        vec3<float> v(std::max(0.f, sh_lane(r[k / 8], k % 8)), std::max(0.f, sh_lane(g[k / 8], k % 8)),
-                      std::max(0.f, sh_lane(b[k / 8], k % 8)));
+    for (std::size_t k = 0; k < L * C && x + int(k) < n; ++k) {
+        vec3<float> v(std::max(0.f, sh_lane_of(r[k / L], k % L)), std::max(0.f, sh_lane_of(g[k / L], k % L)),
+                      std::max(0.f, sh_lane_of(b[k / L], k % L)));
         if (norm && norm[x + int(k)] > 0.f) v /= norm[x + int(k)];
         out[x + int(k)] = v;
     }
+}
+inline void sh_level_lanes16(const sh_level& lv, int face, int x, int y, int n, vec3<float>* out, const float* norm) noexcept {
+#if defined(IBL_DETAIL_SH_F16)
+    sh_level_lanes<sh_f16, 16>(lv, face, x, y, n, out, norm);
+#else
+    sh_level_lanes<sh_f8, 8>(lv, face, x, y, n, out, norm);
+#endif
 }
 /// Row y of face `face` of an n x n level from its coefficients, sixteen texels at a time, divided
 /// by the level's norm.
