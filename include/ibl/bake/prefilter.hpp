@@ -525,10 +525,26 @@ template <class TexelFn> cubemap<float> prefilter_tail_cube(int n, TexelFn&& tex
     c.update_borders();
     return c;
 }
-/// Adds share times the next level, read at the texel centres of row y of face `face` (n x n).
+/// Adds share times the next level, read at the texel centres of row y of face `face` (n x n):
+/// cubemap::bilinear(face, s, t, 0) at s = (x + 1/2) / n, the same operations texel by texel, with
+/// the row's two source rows found once (the texel loop then vectorises).
 inline void add_coarse_tail_row(const cubemap<float>& next, float share, int face, int y, int n, vec3<float>* out) {
     const float t = (float(y) + 0.5f) / float(n);
-    for (int x = 0; x < n; ++x) out[x] += share * next.bilinear(face, (float(x) + 0.5f) / float(n), t, 0);
+    const int m = next.size(0);
+    // bilinear_unchecked's row: bordered coordinates, t in (0, 1) so no clamp applies
+    const float fy = t * float(m) + 0.5f;
+    const int y0 = std::min(int(fy), m);
+    const float wy = fy - float(y0);
+    const vec3<float>* r0 = &next.texel(face, -1, y0 - 1, 0); // bordered row y0 from its x = -1
+    const vec3<float>* r1 = &next.texel(face, -1, y0, 0);
+    for (int x = 0; x < n; ++x) {
+        const float fx = ((float(x) + 0.5f) / float(n)) * float(m) + 0.5f;
+        const int x0 = std::min(int(fx), m);
+        const float wx = fx - float(x0);
+        const vec3<float> top = r0[x0] + wx * (r0[x0 + 1] - r0[x0]);
+        const vec3<float> bot = r1[x0] + wx * (r1[x0 + 1] - r1[x0]);
+        out[x] += share * (top + wy * (bot - top));
+    }
 }
 
 /// A convolved level of a cubemap source: its taps, its peaks and its coarse tail's share.
