@@ -618,25 +618,52 @@ public:
         : opt_(opt) {
         restart(src, ex);
     }
+    /// An empty source for restart_deferred (prefilter_update).
+    explicit prefilter_cube_source(const prefilter_options& opt) : opt_(opt) {}
     /// Deferred packing of a new source: the peak split again, the packed copy's storage kept when
     /// the source has the same levels (every packing item overwrites its texels).
     template <class Executor> void restart(const cubemap<T>& src, Executor& ex) {
-        const bool same_layout = int(packed_.levels.size()) == src.levels() && n0_ == src.size(0) && !packed_.data.empty();
-        n0_ = src.size(0);
-        table_source_levels_ = src.levels();
-        peaks_.clear();
-        mean_ = threshold_ = 0.0;
-        if constexpr (std::is_same_v<Lobe, ggx_lobe>) {
-            if (opt_.method == prefilter_method::fast && opt_.peaks.enabled) {
-                cube_peak_split<T> split = find_cube_peaks(src, opt_.peaks, ex);
-                peaks_ = std::move(split.peaks);
-                mean_ = split.mean_luminance;
-                threshold_ = split.threshold;
-            }
+        reset(src);
+        if (splits()) set_split(find_cube_peaks(src, opt_.peaks, ex));
+    }
+    /// The same with the split left to the caller too (prefilter_update): split_row every row of
+    /// split_rows(), then split_select(), then split_build every peak of split_peaks(), and the
+    /// object is the one restart makes (the same operations: the same peaks). A source whose mips
+    /// do not reach 1 x 1 is split at once (its mean needs a pass over level 0 first): split_rows()
+    /// is then 0 and the split is done.
+    void restart_deferred(const cubemap<T>& src) {
+        reset(src);
+        split_pending_ = scanned_ = false;
+        hits_.clear();
+        if (!splits()) return;
+        if (peak_scan_start(src, opt_.peaks, scan_)) {
+            split_pending_ = scanned_ = true;
+            scan_row_.resize(std::size_t(src.size(0)));
+            return;
         }
-        if (!same_layout) packed_ = packed_layout(src);
-        sh_ready_ = false;
-        proj_.clear();
+        serial_executor one;
+        set_split(find_cube_peaks(src, opt_.peaks, one));
+    }
+    /// True until split_select: the scan's rows and the selection are due.
+    [[nodiscard]] bool split_pending() const noexcept { return split_pending_; }
+    /// The rows of this pass's scan (0 when the pass has none), and the texels it kept so far (the
+    /// selection's cost).
+    [[nodiscard]] std::size_t split_rows() const noexcept { return scanned_ ? scan_.rows.size() : 0; }
+    [[nodiscard]] std::size_t split_hits() const noexcept { return scanned_ ? scan_.hits : 0; }
+    void split_row(const cubemap<T>& src, std::size_t r) noexcept { scan_.hits += peak_scan_row(src, scan_, r, scan_row_.data()); }
+    /// The threshold (select_peak_threshold) and the peaks' slots; split_build fills them.
+    void split_select() {
+        hits_ = peak_scan_hits(scan_);
+        threshold_ = select_peak_threshold(opt_.peaks, hits_, scan_.t);
+        mean_ = scan_.mean;
+        if (threshold_ > 0.0) peaks_.resize(hits_.size());
+        else hits_.clear();
+        split_pending_ = false;
+    }
+    /// The peaks the selection kept (after split_select), and peaks [b, e) built.
+    [[nodiscard]] std::size_t split_peaks() const noexcept { return hits_.size(); }
+    void split_build(const cubemap<T>& src, std::size_t b, std::size_t e) noexcept {
+        for (std::size_t h = b; h < e; ++h) peaks_[h] = make_cube_peak(src, hits_[h], threshold_);
     }
     /// The spherical-harmonic projection for levels of up to `bands` bands (0: none), after the
     /// packing: sh_add_row every row of sh_rows() (a face's rows in order), then sh_finish().
@@ -777,6 +804,28 @@ public:
     [[nodiscard]] std::size_t peak_count() const noexcept { return peaks_.size(); }
 
 private:
+    /// A new source's state before its split: no peaks, the packed layout kept when the source has
+    /// the same levels.
+    void reset(const cubemap<T>& src) {
+        const bool same_layout = int(packed_.levels.size()) == src.levels() && n0_ == src.size(0) && !packed_.data.empty();
+        n0_ = src.size(0);
+        table_source_levels_ = src.levels();
+        peaks_.clear();
+        mean_ = threshold_ = 0.0;
+        if (!same_layout) packed_ = packed_layout(src);
+        sh_ready_ = false;
+        proj_.clear();
+    }
+    /// True when the options split the source's peaks (the fast filter's, the GGX lobe).
+    [[nodiscard]] bool splits() const noexcept {
+        if constexpr (std::is_same_v<Lobe, ggx_lobe>) return opt_.method == prefilter_method::fast && opt_.peaks.enabled;
+        else return false;
+    }
+    void set_split(cube_peak_split<T>&& split) {
+        peaks_ = std::move(split.peaks);
+        mean_ = split.mean_luminance;
+        threshold_ = split.threshold;
+    }
     static double clamped(double r) noexcept { return std::clamp(std::isfinite(r) ? r : 0.0, 0.0, 1.0); }
     prefilter_options opt_;
     int n0_ = 1, table_source_levels_ = 1;
@@ -786,6 +835,11 @@ private:
     sh_projection proj_{};
     std::vector<double> sh_coef_;
     bool sh_ready_ = false;
+    peak_scan scan_{};            ///< the deferred split's scan (restart_deferred)
+    std::vector<float> scan_row_; ///< its scratch row
+    std::vector<std::pair<std::size_t, float>> hits_; ///< the texels the selection kept (split_build's)
+    bool split_pending_ = false;  ///< the scan's rows or the selection are due
+    bool scanned_ = false;        ///< this source's split is a deferred scan
 };
 /// The most bands of the plan's levels by spherical harmonics (0: none).
 template <class Lobe> int prefilter_sh_max_bands(const prefilter_options& opt, const std::vector<prefilter_level>& plan) {

@@ -137,119 +137,172 @@ template <class T> bool peak_mips_nest(const cubemap<T>& src) noexcept {
     return true;
 }
 
+/// double(l) > t for a float l (>= 0, finite) is l >= least_float_above(t), so the scans compare
+/// floats (they vectorise).
+inline float least_float_above(double v) noexcept {
+    if (!(v < double(std::numeric_limits<float>::max()))) return std::numeric_limits<float>::infinity();
+    float f = float(v);
+    while (!(double(f) > v)) f = std::nextafter(f, std::numeric_limits<float>::infinity());
+    return f;
+}
+/// A level-0 texel's luminance as the split reads it (non-finite or negative: 0).
+template <class T> float peak_texel_luminance(const cubemap<T>& src, int f, int x, int y) noexcept {
+    const float l = float(luminance(src.texel(f, x, y, 0)));
+    return std::isfinite(l) && l > 0.f ? l : 0.f;
+}
+
+/// The split's scan of level 0 in units of one face row (prefilter_update spreads it over its
+/// calls; find_cube_peaks runs the rows through its executor): peak_scan_start finds the mean
+/// and the ratio's threshold from a 1 x 1 coarsest level (false, nothing started, without one),
+/// peak_scan_row(r) keeps row r's texels above it, and peak_scan_finish selects the threshold
+/// and builds the peaks (peaks_from_hits: select_peak_threshold, then make_cube_peak of each).
+/// The same peaks as one find_cube_peaks.
+struct peak_scan {
+    int n = 0;
+    double mean = 0.0, t = 0.0;
+    float above_t = 0.f;
+    std::vector<std::vector<std::pair<std::size_t, float>>> rows; ///< per face row: (cube_texel_index, luminance)
+    std::size_t hits = 0;                                         ///< texels kept so far
+};
+template <class T> bool peak_scan_start(const cubemap<T>& src, const peak_split_options& opt, peak_scan& sc) {
+    const int top = src.levels() - 1;
+    if (src.size(top) != 1) return false;
+    // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
+    // so a chain down to 1 x 1 gives it in six reads.
+    double acc = 0.0;
+    for (int f = 0; f < 6; ++f) {
+        const double l = double(luminance(src.texel(f, 0, 0, top)));
+        acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
+    }
+    sc.n = src.size(0);
+    sc.mean = acc / 6.0;
+    sc.t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * sc.mean : 0.0;
+    sc.above_t = least_float_above(sc.t);
+    sc.rows.resize(std::size_t(6 * sc.n));
+    for (auto& r : sc.rows) r.clear();
+    sc.hits = 0;
+    return true;
+}
+/// Row r (face n + y) of the scan (rows without a texel above skipped at once: the count
+/// vectorises); `row` is scratch of n floats. Rows are independent (any order, any thread; hits
+/// is then the caller's to add up).
+template <class T> std::size_t peak_scan_row(const cubemap<T>& src, peak_scan& sc, std::size_t r, float* row) noexcept {
+    const int n = sc.n, f = int(r) / n, y = int(r) % n;
+    for (int x = 0; x < n; ++x) row[x] = peak_texel_luminance(src, f, x, y);
+    int in_row = 0;
+    for (int x = 0; x < n; ++x) in_row += row[x] >= sc.above_t ? 1 : 0;
+    std::vector<std::pair<std::size_t, float>>& out = sc.rows[r];
+    out.clear();
+    if (in_row == 0) return 0;
+    out.reserve(std::size_t(in_row));
+    for (int x = 0; x < n; ++x)
+        if (row[x] >= sc.above_t) out.emplace_back(cube_texel_index(f, x, y, n), row[x]);
+    return out.size();
+}
+/// The threshold that keeps at most max_peaks of the texels above t (in cube_texel_index order),
+/// those others taken out of hits.
+inline double select_peak_threshold(const peak_split_options& opt, std::vector<std::pair<std::size_t, float>>& hits, double t) {
+    if (hits.size() <= opt.max_peaks) return t;
+    // The (max_peaks + 1)-th brightest texel is among these texels above t: the selection runs
+    // over those only (a few thousand, not the whole level), and the texels above the new
+    // threshold are among them, in the same order.
+    std::vector<float> sorted(hits.size());
+    for (std::size_t i = 0; i < hits.size(); ++i) sorted[i] = hits[i].second;
+    const std::size_t k = hits.size() - 1 - std::size_t(opt.max_peaks);
+    std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
+    t = std::max(t, double(sorted[k]));
+    const float above_t = least_float_above(t);
+    std::erase_if(hits, [&](const std::pair<std::size_t, float>& h) { return !(h.second >= above_t); });
+    return t;
+}
+/// The peak of a texel above the threshold t (hit: its cube_texel_index and luminance).
+template <class T> cube_peak make_cube_peak(const cubemap<T>& src, const std::pair<std::size_t, float>& hit, double t) noexcept {
+    const int n = src.size(0);
+    const std::size_t nn = std::size_t(n) * std::size_t(n), i = hit.first;
+    const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
+    const float l = hit.second;
+    const vec3<double> v(src.texel(f, x, y, 0));
+    const double om = cube_texel_solid_angle<double>(x, y, n);
+    cube_peak p;
+    p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
+    p.energy = v * ((1.0 - t / double(l)) * om);
+    p.weight = (double(l) - t) * om;
+    p.luminance = l;
+    p.face = f, p.x = x, p.y = y;
+    return p;
+}
+/// The peaks from the texels above t (in cube_texel_index order): the threshold raised to keep
+/// at most max_peaks of them, then each peak (the exact solid angle's four atan2 make this the
+/// split's dearest serial part otherwise: through the executor).
+template <class T, class Executor>
+cube_peak_split<T> peaks_from_hits(const cubemap<T>& src, const peak_split_options& opt, std::vector<std::pair<std::size_t, float>>& hits,
+                                   double t, double mean, Executor& ex) {
+    cube_peak_split<T> s;
+    s.mean_luminance = mean;
+    t = select_peak_threshold(opt, hits, t);
+    s.threshold = t;
+    if (!(t > 0.0)) return s;
+    s.peaks.resize(hits.size());
+    ex(hits.size(), [&](std::size_t b, std::size_t e) {
+        for (std::size_t h = b; h < e; ++h) s.peaks[h] = make_cube_peak(src, hits[h], t);
+    });
+    return s;
+}
+/// The texels the scan kept, in cube_texel_index order.
+inline std::vector<std::pair<std::size_t, float>> peak_scan_hits(const peak_scan& sc) {
+    std::vector<std::pair<std::size_t, float>> hits;
+    std::size_t total = 0;
+    for (const auto& rh : sc.rows) total += rh.size();
+    hits.reserve(total);
+    for (const auto& rh : sc.rows) hits.insert(hits.end(), rh.begin(), rh.end());
+    return hits;
+}
+template <class T, class Executor> cube_peak_split<T> peak_scan_finish(const cubemap<T>& src, const peak_split_options& opt, peak_scan& sc, Executor& ex) {
+    std::vector<std::pair<std::size_t, float>> hits = peak_scan_hits(sc);
+    return peaks_from_hits(src, opt, hits, sc.t, sc.mean, ex);
+}
+
 /// The peaks and the threshold of split_cube_peaks, without the base.
 template <class T, class Executor>
 cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_options& opt, Executor& ex) {
-    cube_peak_split<T> s;
-    if (!opt.enabled) return s;
+    if (!opt.enabled) return {};
     const int n = src.size(0);
-    const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
-    auto lum_of = [&](int f, int x, int y) {
-        const float l = float(luminance(src.texel(f, x, y, 0)));
-        return std::isfinite(l) && l > 0.f ? l : 0.f;
-    };
-    // double(l) > t for a float l (>= 0, finite) is l >= above_t, the least float above t, so the
-    // scans compare floats (they vectorise).
-    auto least_float_above = [](double v) {
-        if (!(v < double(std::numeric_limits<float>::max()))) return std::numeric_limits<float>::infinity();
-        float f = float(v);
-        while (!(double(f) > v)) f = std::nextafter(f, std::numeric_limits<float>::infinity());
-        return f;
-    };
-    // The texels above t (cube_texel_index, luminance), in cube_texel_index order (face, row, column).
-    std::vector<std::pair<std::size_t, float>> hits;
-    double t = 0.0;
-    float above_t = 0.f;
-    const auto threshold_of = [&](double mean) {
-        s.mean_luminance = mean;
-        t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * mean : 0.0;
-        above_t = least_float_above(t);
-    };
-    const int top = src.levels() - 1;
-    if (src.size(top) == 1) {
-        // The mean: the coarsest level's texels are exact solid-angle means (cubemap::generate_mips),
-        // so a chain down to 1 x 1 gives it in six reads, and one pass over level 0 finds the
-        // texels above t, each row its own (rows without any skipped at once: the count vectorises).
-        double acc = 0.0;
-        for (int f = 0; f < 6; ++f) {
-            const double l = double(luminance(src.texel(f, 0, 0, top)));
-            acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
-        }
-        threshold_of(acc / 6.0);
-        std::vector<std::vector<std::pair<std::size_t, float>>> row_hits(std::size_t(6 * n));
+    peak_scan sc;
+    if (peak_scan_start(src, opt, sc)) { // one pass over level 0, each row its own
         ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
             std::vector<float> row(static_cast<std::size_t>(n));
-            for (std::size_t r = b; r < e; ++r) {
-                const int f = int(r) / n, y = int(r) % n;
-                for (int x = 0; x < n; ++x) row[std::size_t(x)] = lum_of(f, x, y);
-                int in_row = 0;
-                for (int x = 0; x < n; ++x) in_row += row[std::size_t(x)] >= above_t ? 1 : 0;
-                if (in_row == 0) continue;
-                row_hits[r].reserve(std::size_t(in_row));
-                for (int x = 0; x < n; ++x)
-                    if (row[std::size_t(x)] >= above_t) row_hits[r].emplace_back(cube_texel_index(f, x, y, n), row[std::size_t(x)]);
-            }
+            for (std::size_t r = b; r < e; ++r) peak_scan_row(src, sc, r, row.data());
         });
-        for (const auto& rh : row_hits) hits.insert(hits.end(), rh.begin(), rh.end());
-    } else {
-        // Otherwise the mean of level 0 by texel solid angles, then the scan.
-        std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
-        ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-            for (std::size_t row = b; row < e; ++row) {
-                const int f = int(row) / n, y = int(row) % n;
-                for (int x = 0; x < n; ++x) lum[cube_texel_index(f, x, y, n)] = lum_of(f, x, y);
-            }
-        });
-        const std::vector<double> omega = cube_face_solid_angles<double>(n);
-        double acc = 0.0;
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
-                    acc += double(lum[cube_texel_index(f, x, y, n)]) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
-        threshold_of(acc / four_pi_v<double>);
-        for (std::size_t b = 0; b < count; b += 64) {
-            const std::size_t e = std::min(count, b + 64);
-            int in_block = 0;
-            for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
-            if (in_block > 0)
-                for (std::size_t i = b; i < e; ++i)
-                    if (lum[i] >= above_t) hits.emplace_back(i, lum[i]);
-        }
+        return peak_scan_finish(src, opt, sc, ex);
     }
-    if (hits.size() > opt.max_peaks) { // the threshold that keeps at most max_peaks texels above it
-        // The (max_peaks + 1)-th brightest texel is among these texels above t: the selection
-        // runs over those only (a few thousand, not the whole level), and the texels above the
-        // new threshold are among them, in the same order.
-        std::vector<float> sorted(hits.size());
-        for (std::size_t i = 0; i < hits.size(); ++i) sorted[i] = hits[i].second;
-        const std::size_t k = hits.size() - 1 - std::size_t(opt.max_peaks);
-        std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(k), sorted.end());
-        t = std::max(t, double(sorted[k]));
-        above_t = least_float_above(t);
-        std::erase_if(hits, [&](const std::pair<std::size_t, float>& h) { return !(h.second >= above_t); });
-    }
-    s.threshold = t;
-    if (!(t > 0.0)) return s;
-    // The peaks through the executor (each one its own: the exact solid angle's four atan2 make
-    // this the split's dearest serial part otherwise).
-    const std::size_t nn = std::size_t(n) * std::size_t(n);
-    s.peaks.resize(hits.size());
-    ex(hits.size(), [&](std::size_t b, std::size_t e) {
-        for (std::size_t h = b; h < e; ++h) {
-            const std::size_t i = hits[h].first;
-            const int f = int(i / nn), y = int((i % nn) / std::size_t(n)), x = int(i % std::size_t(n));
-            const float l = hits[h].second;
-            const vec3<double> v(src.texel(f, x, y, 0));
-            const double om = cube_texel_solid_angle<double>(x, y, n);
-            cube_peak& p = s.peaks[h];
-            p.dir = normalize(cube_texel_direction<float>(f, x, y, n));
-            p.energy = v * ((1.0 - t / double(l)) * om);
-            p.weight = (double(l) - t) * om;
-            p.luminance = l;
-            p.face = f, p.x = x, p.y = y;
+    // Otherwise the mean of level 0 by texel solid angles, then the scan.
+    const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
+    std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
+    ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
+        for (std::size_t row = b; row < e; ++row) {
+            const int f = int(row) / n, y = int(row) % n;
+            for (int x = 0; x < n; ++x) lum[cube_texel_index(f, x, y, n)] = peak_texel_luminance(src, f, x, y);
         }
     });
-    return s;
+    const std::vector<double> omega = cube_face_solid_angles<double>(n);
+    double acc = 0.0;
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < n; ++y)
+            for (int x = 0; x < n; ++x)
+                acc += double(lum[cube_texel_index(f, x, y, n)]) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+    const double mean = acc / four_pi_v<double>;
+    const double t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * mean : 0.0;
+    const float above_t = least_float_above(t);
+    std::vector<std::pair<std::size_t, float>> hits;
+    for (std::size_t b = 0; b < count; b += 64) {
+        const std::size_t e = std::min(count, b + 64);
+        int in_block = 0;
+        for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
+        if (in_block > 0)
+            for (std::size_t i = b; i < e; ++i)
+                if (lum[i] >= above_t) hits.emplace_back(i, lum[i]);
+    }
+    return peaks_from_hits(src, opt, hits, t, mean, ex);
 }
 } // namespace detail
 

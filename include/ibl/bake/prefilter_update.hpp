@@ -50,7 +50,14 @@
 // just before the level that reads it, written only into its own cube (it has no peaks and no
 // place in the chain); unit_taps of the level that reads it counts its units too.
 //
-// A pass starts with more units: the packed copy of the source that the taps read, a bordered row
+// A pass starts with more units. With the fast filter's peak split (bake/prefilter_peaks.hpp)
+// first the split itself: its scan of level 0, a face row per unit (1 + n taps: a texel to a tap),
+// its selection of the threshold (1 + H / 2 taps, H the texels above the ratio's threshold), its
+// peaks, 64 to a unit (1 + 48 taps a peak: an exact solid angle each), and each output level's
+// merged peak list, a level per unit (1 + 8 P taps); a source whose mips do not reach 1 x 1 is
+// split by set_source instead (its mean needs a pass over level 0 first). Until those units are
+// done, the pass's rows count no peaks: total_taps() and remaining_taps() are exact from then on
+// (peaks_ready()). Then the packed copy of the source that the taps read, a bordered row
 // of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
 // filter's peak split, the patch that takes the peaks out of it (1 + 8 P L taps, P peaks, L levels),
 // then, when the fast filter reconstructs rough levels from spherical harmonics
@@ -70,11 +77,11 @@
 // BM_prefilter_update_time).
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
-// copy of every texel, none when the source is moved in), runs the fast filter's peak split (a pass
-// over level 0's luminance) and, for a first pass or a source of another shape, plans the levels
-// and allocates the packed copy, the chain under construction and the as_next cubes (later passes
-// reuse the storage). Measured at 256^2 after a pass (cold caches): 0.9-1.6 ms with a copy, about
-// 0.01 ms moved in, plus about 0.4-0.9 ms for the split (docs/ARCHITECTURE.md, "Dynamic probes").
+// copy of every texel, none when the source is moved in) and, for a first pass or a source of
+// another shape, plans the levels and allocates the packed copy, the chain under construction and
+// the as_next cubes (later passes reuse the storage). Measured on the courtyard at 256^2, one
+// thread (bench_prefilter_hdri BM_hdri_update_set_source, with a copy): 0.48 ms, 0.96 ms while the
+// peak split ran in set_source; moved in, a few microseconds (docs/ARCHITECTURE.md, "Dynamic probes").
 //
 // Domain: a cubemap<float> source with its mip chain (cubemap::generate_mips); the options of
 // prefilter (the same checks and exceptions, at construction). budget 0 computes nothing.
@@ -190,9 +197,11 @@ public:
     bool done() const noexcept { return pass_done_; }
     /// The last finished chain (empty before the first pass finishes).
     const std::optional<specular_chain>& result() const noexcept { return result_; }
-    /// Taps of a whole pass, and those still to compute in the current one.
+    /// Taps of a whole pass, and those still to compute in the current one. Both are exact once
+    /// peaks_ready(); before, the split's units (header comment) count the texels its scan kept so
+    /// far and the levels' rows count no peaks, so they grow as the split finds them.
     std::uint64_t total_taps() const noexcept {
-        std::uint64_t t = setup_taps(0) + patch_taps() + sh_taps(0);
+        std::uint64_t t = whole_split_taps() + setup_taps(0) + patch_taps() + sh_taps(0);
         for (const level_work& lw : levels_) t += level_taps(lw);
         return t;
     }
@@ -200,7 +209,7 @@ public:
         if (pass_done_) return 0;
         const std::uint64_t sh = sh_done_ ? 0 : sh_taps(sh_row_);
         if (!packed_) {
-            std::uint64_t t = setup_taps(pack_item_) + patch_taps() + sh;
+            std::uint64_t t = split_taps() + setup_taps(pack_item_) + patch_taps() + sh;
             for (const level_work& w : levels_) t += level_taps(w);
             return t;
         }
@@ -214,6 +223,11 @@ public:
         for (std::size_t p = pos_ + 1; p < order_.size(); ++p) t += level_taps(levels_[order_[p]]);
         return t;
     }
+    /// True once the pass's peak split and every level's merged peaks are done (its first units):
+    /// from then on the pass's taps are known exactly.
+    bool peaks_ready() const noexcept {
+        return split_selected_ && split_peak_ >= src_->split_peaks() && peaks_level_ >= plan_.size();
+    }
     /// The pass's plan (prefilter_plan of the options for this source).
     const std::vector<prefilter_level>& plan() const noexcept { return plan_; }
     /// Face size of output level k, the taps of one of its rows and of its dearest work unit
@@ -224,7 +238,11 @@ public:
     /// The dearest of a pass's first units (a packed row of the source, the split's patch, a row of
     /// the projection by spherical harmonics).
     std::uint64_t setup_unit_taps() const noexcept {
-        return std::max({pack_unit_taps(), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
+        const std::uint64_t split = std::max({src_->split_rows() > 0 ? split_row_taps() : std::uint64_t(0),
+                                              src_->split_pending() ? split_select_taps() : std::uint64_t(0),
+                                              peak_build_taps(std::min<std::size_t>(peak_build_unit, std::max(src_->split_peaks(), src_->split_pending() ? std::size_t(opt_.peaks.max_peaks) : std::size_t(0)))),
+                                              level_peaks_taps()});
+        return std::max({split, pack_unit_taps(), patch_taps(), src_->sh_rows() > 0 ? std::max(sh_row_taps(), sh_finish_taps()) : std::uint64_t(0)});
     }
     /// (A level that reads an intermediate level, prefilter_options::mid_tail, counts that
     /// level's units too.)
@@ -240,7 +258,45 @@ private:
         std::uint64_t spent = 0;
         bool stop = false;
         while (!pass_done_ && !stop && spent < budget) {
-            if (!packed_) { // the pass's first units: the packed copy of the source, then the split's patch
+            if (!split_selected_) { // the pass's first units: the peak split's scan, a row per unit, then its selection
+                if (src_->split_pending() && split_row_ < src_->split_rows()) {
+                    const std::uint64_t c = split_row_taps();
+                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    src_->split_row(*source_, split_row_++);
+                    spent += c;
+                    continue;
+                }
+                if (src_->split_pending()) {
+                    const std::uint64_t c = split_select_taps();
+                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    src_->split_select();
+                    spent += c;
+                }
+                split_selected_ = true;
+                continue;
+            }
+            if (split_peak_ < src_->split_peaks()) { // the peaks, peak_build_unit a unit
+                const std::size_t e = std::min(src_->split_peaks(), split_peak_ + peak_build_unit);
+                const std::uint64_t c = peak_build_taps(e - split_peak_);
+                if ((spent > 0 || !progress) && c > budget - spent) break;
+                src_->split_build(*source_, split_peak_, e);
+                split_peak_ = e;
+                spent += c;
+                continue;
+            }
+            if (peaks_level_ < plan_.size()) { // each output level's merged peaks, a level per unit
+                const std::uint64_t c = level_peaks_taps();
+                if ((spent > 0 || !progress) && c > budget - spent) break;
+                level_work& w = levels_[peaks_level_];
+                if (!w.mirror) {
+                    w.conv.peaks = src_->level_peaks(plan_[peaks_level_]);
+                    set_convolved_costs(w);
+                }
+                ++peaks_level_;
+                spent += c;
+                continue;
+            }
+            if (!packed_) { // then the packed copy of the source, then the split's patch
                 if (pack_item_ < src_->pack_items()) {
                     const std::uint64_t c = pack_item_taps(pack_item_);
                     if ((spent > 0 || !progress) && c > budget - spent) break;
@@ -335,11 +391,14 @@ private:
 
     /// The new pass on source_ (set_source).
     void restart(bool same_shape) {
-        serial_executor ex;
-        // The peak split now; the packing in the pass's first units (into the same storage when
-        // the shape is unchanged).
-        if (src_) src_->restart(*source_, ex);
-        else src_.emplace(*source_, opt_, ex, 0);
+        // The peak split, the levels' peak lists and the packing in the pass's first units (into
+        // the same storage when the shape is unchanged).
+        if (!src_) src_.emplace(opt_);
+        src_->restart_deferred(*source_);
+        split_row_ = 0;
+        split_peak_ = 0;
+        split_selected_ = false;
+        peaks_level_ = 0;
         pack_item_ = 0;
         packed_ = false;
         sh_row_ = 0;
@@ -352,12 +411,13 @@ private:
             src_->set_first_packed(src_->first_read_level(*source_, plan_, first_size_));
         } else { // the tables stay; the peaks of the fast filter's split belong to the source
             src_->sh_setup(detail::prefilter_sh_max_bands<Lobe>(opt_, plan_)); // the projection's rows: the pass's next units
-            for (std::size_t k = 0; k < plan_.size(); ++k) // an intermediate level has no peaks
-                if (!levels_[k].mirror) {
-                    levels_[k].conv.peaks = src_->level_peaks(plan_[k]);
-                    set_convolved_costs(levels_[k]);
-                }
         }
+        // The levels' peak lists are units after the split (an intermediate level has none).
+        for (std::size_t k = 0; k < plan_.size(); ++k)
+            if (!levels_[k].mirror) {
+                levels_[k].conv.peaks = {};
+                set_convolved_costs(levels_[k]);
+            }
         // The chain under construction (the rows are written into it; outside the budget).
         if (!back_ || back_->levels() != int(plan_.size()) || back_->size(0) != first_size_)
             back_.emplace(first_size_, int(plan_.size()));
@@ -403,6 +463,37 @@ private:
             ++l;
         }
         return t;
+    }
+    /// The split's scan: a row of level 0 (a luminance and a comparison a texel, scan_per_tap
+    /// texels a tap: the source was just copied and its level 0 is read once, from memory, so a
+    /// texel costs about a tap; 4 texels a tap took the 99th percentile of 2^20-tap calls from 1.2
+    /// to 1.6 times their budget's time, bench_prefilter BM_prefilter_update_step), its selection (a
+    /// copy and a partial sort of the texels it kept, select_per_tap of them a tap), its peaks (an
+    /// exact solid angle's four atan2 and a normalisation each, about 100 ns: build_taps_per_peak
+    /// taps, peak_build_unit peaks a unit) and each level's merged peak list (one to three merges of
+    /// the peaks' keys by a stable sort: merge_taps_per_peak taps a peak).
+    static constexpr std::size_t scan_per_tap = 1, select_per_tap = 2, build_taps_per_peak = 48, peak_build_unit = 64,
+                                 merge_taps_per_peak = 8;
+    std::uint64_t split_row_taps() const noexcept { return 1 + (std::uint64_t(first_source_size()) + scan_per_tap - 1) / scan_per_tap; }
+    std::uint64_t split_select_taps() const noexcept { return 1 + (std::uint64_t(src_->split_hits()) + select_per_tap - 1) / select_per_tap; }
+    static std::uint64_t peak_build_taps(std::size_t peaks) noexcept { return 1 + std::uint64_t(peaks) * build_taps_per_peak; }
+    std::uint64_t level_peaks_taps() const noexcept { return 1 + std::uint64_t(src_->peak_count()) * merge_taps_per_peak; }
+    int first_source_size() const noexcept { return source_ ? source_->size(0) : 1; }
+    /// The split's units from the current one on (the selection and the peaks at what the scan
+    /// has kept so far, at most max_peaks peaks).
+    std::uint64_t split_taps() const noexcept { return split_taps_from(split_row_, split_peak_, peaks_level_); }
+    /// A whole pass's split units.
+    std::uint64_t whole_split_taps() const noexcept { return split_taps_from(0, 0, 0); }
+    std::uint64_t split_taps_from(std::size_t row, std::size_t peak, std::size_t level) const noexcept {
+        const bool selected = split_selected_ && row >= src_->split_rows();
+        std::uint64_t t = std::uint64_t(src_->split_rows() - std::min(src_->split_rows(), row)) * split_row_taps();
+        std::size_t peaks = src_->split_peaks();
+        if (!selected && src_->split_rows() > 0) { // the selection, and the peaks it will keep at most
+            t += split_select_taps();
+            if (src_->split_pending()) peaks = std::min<std::size_t>(src_->split_hits(), opt_.peaks.max_peaks);
+        }
+        for (std::size_t p = peak; p < peaks; p += peak_build_unit) t += peak_build_taps(std::min<std::size_t>(peak_build_unit, peaks - p));
+        return t + std::uint64_t(plan_.size() - std::min(plan_.size(), level)) * level_peaks_taps();
     }
     /// The split's patch: a few texels per peak and level of the packed copy.
     std::uint64_t patch_taps() const noexcept { return 1 + 8 * std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
@@ -640,6 +731,10 @@ private:
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
     std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
     std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
+    std::size_t split_row_ = 0;         ///< the next row of the peak split's scan (the pass's first units)
+    bool split_selected_ = false;       ///< the split's selection done (or none due)
+    std::size_t split_peak_ = 0;        ///< the next peak to build
+    std::size_t peaks_level_ = 0;       ///< the next output level whose merged peaks to make
     std::size_t pack_item_ = 0;         ///< the next packing item of the pass's first units
     std::size_t sh_row_ = 0;            ///< the next row of the projection by spherical harmonics
     bool sh_done_ = false;              ///< its sums reduced and the levels' coefficients set
