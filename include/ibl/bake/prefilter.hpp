@@ -898,9 +898,11 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                     const int nm = std::max(1, n / 2);
                     const detail::prefilter_cube_level lm = cs.mid_level(env, lp, rm, rn, nm, ex);
                     mid.emplace(nm, 1, detail::for_overwrite);
+                    // the rows' storage taken before the work items (texel_ref marks the borders stale)
+                    std::vector<vec3<float>*> mid_rows(std::size_t(6 * nm));
+                    for (int r = 0; r < 6 * nm; ++r) mid_rows[std::size_t(r)] = &mid->texel_ref(r / nm, 0, r % nm, 0);
                     ex(std::size_t(6 * nm), [&](std::size_t b, std::size_t e) {
-                        for (std::size_t row = b; row < e; ++row)
-                            cs.row(lm, row, nm, &mid->texel_ref(int(row) / nm, 0, int(row) % nm, 0), nx, nullptr);
+                        for (std::size_t row = b; row < e; ++row) cs.row(lm, row, nm, mid_rows[row], nx, nullptr);
                     });
                     mid->update_borders();
                     nx = &*mid;
@@ -910,11 +912,13 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 // (they are added to every level exactly, through its own kernel).
                 // Those rows go straight into the bordered cube that level reads.
                 std::optional<cubemap<float>> tail;
-                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0)
+                std::vector<vec3<float>*> tail_rows(std::size_t(6 * n), nullptr);
+                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0) {
                     tail.emplace(n, 1, detail::for_overwrite);
+                    for (int r = 0; r < 6 * n; ++r) tail_rows[std::size_t(r)] = &tail->texel_ref(r / n, 0, r % n, 0);
+                }
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-                    for (std::size_t row = b; row < e; ++row)
-                        cs.row(lv, row, n, rows[row], nx, tail ? &tail->texel_ref(int(row) / n, 0, int(row) % n, 0) : nullptr);
+                    for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row], nx, tail_rows[row]);
                 });
                 if (tail) {
                     tail->update_borders();
