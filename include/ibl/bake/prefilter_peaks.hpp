@@ -164,6 +164,17 @@ struct peak_scan {
     std::vector<std::vector<std::pair<std::size_t, float>>> rows; ///< per face row: (cube_texel_index, luminance)
     std::size_t hits = 0;                                         ///< texels kept so far
 };
+/// The scan of an n-texel level 0 whose luminance has this mean: the ratio's threshold, no rows
+/// scanned yet.
+inline void peak_scan_reset(const peak_split_options& opt, int n, double mean, peak_scan& sc) {
+    sc.n = n;
+    sc.mean = mean;
+    sc.t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * mean : 0.0;
+    sc.above_t = least_float_above(sc.t);
+    sc.rows.resize(std::size_t(6 * n));
+    for (auto& r : sc.rows) r.clear();
+    sc.hits = 0;
+}
 template <class T> bool peak_scan_start(const cubemap<T>& src, const peak_split_options& opt, peak_scan& sc) {
     const int top = src.levels() - 1;
     if (src.size(top) != 1) return false;
@@ -174,13 +185,7 @@ template <class T> bool peak_scan_start(const cubemap<T>& src, const peak_split_
         const double l = double(luminance(src.texel(f, 0, 0, top)));
         acc += std::isfinite(l) && l > 0.0 ? l : 0.0;
     }
-    sc.n = src.size(0);
-    sc.mean = acc / 6.0;
-    sc.t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * sc.mean : 0.0;
-    sc.above_t = least_float_above(sc.t);
-    sc.rows.resize(std::size_t(6 * sc.n));
-    for (auto& r : sc.rows) r.clear();
-    sc.hits = 0;
+    peak_scan_reset(opt, src.size(0), acc / 6.0, sc);
     return true;
 }
 /// Row r (face n + y) of the scan (rows without a texel above skipped at once: the count
@@ -268,41 +273,22 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
     if (!opt.enabled) return {};
     const int n = src.size(0);
     peak_scan sc;
-    if (peak_scan_start(src, opt, sc)) { // one pass over level 0, each row its own
-        ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-            std::vector<float> row(static_cast<std::size_t>(n));
-            for (std::size_t r = b; r < e; ++r) peak_scan_row(src, sc, r, row.data());
-        });
-        return peak_scan_finish(src, opt, sc, ex);
+    if (!peak_scan_start(src, opt, sc)) {
+        // No 1 x 1 level: the mean of level 0 by texel solid angles first (in texel order).
+        const std::vector<double> omega = cube_face_solid_angles<double>(n);
+        double acc = 0.0;
+        for (int f = 0; f < 6; ++f)
+            for (int y = 0; y < n; ++y)
+                for (int x = 0; x < n; ++x)
+                    acc += double(peak_texel_luminance(src, f, x, y)) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+        peak_scan_reset(opt, n, acc / four_pi_v<double>, sc);
     }
-    // Otherwise the mean of level 0 by texel solid angles, then the scan.
-    const std::size_t count = std::size_t(6) * std::size_t(n) * std::size_t(n);
-    std::vector<float, default_init_allocator<float>> lum(count); // every texel written below
+    // One pass over level 0, each row its own.
     ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
-        for (std::size_t row = b; row < e; ++row) {
-            const int f = int(row) / n, y = int(row) % n;
-            for (int x = 0; x < n; ++x) lum[cube_texel_index(f, x, y, n)] = peak_texel_luminance(src, f, x, y);
-        }
+        std::vector<float> row(static_cast<std::size_t>(n));
+        for (std::size_t r = b; r < e; ++r) peak_scan_row(src, sc, r, row.data());
     });
-    const std::vector<double> omega = cube_face_solid_angles<double>(n);
-    double acc = 0.0;
-    for (int f = 0; f < 6; ++f)
-        for (int y = 0; y < n; ++y)
-            for (int x = 0; x < n; ++x)
-                acc += double(lum[cube_texel_index(f, x, y, n)]) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
-    const double mean = acc / four_pi_v<double>;
-    const double t = std::isfinite(opt.ratio) && opt.ratio > 0.0 ? opt.ratio * mean : 0.0;
-    const float above_t = least_float_above(t);
-    std::vector<std::pair<std::size_t, float>> hits;
-    for (std::size_t b = 0; b < count; b += 64) {
-        const std::size_t e = std::min(count, b + 64);
-        int in_block = 0;
-        for (std::size_t i = b; i < e; ++i) in_block += lum[i] >= above_t ? 1 : 0;
-        if (in_block > 0)
-            for (std::size_t i = b; i < e; ++i)
-                if (lum[i] >= above_t) hits.emplace_back(i, lum[i]);
-    }
-    return peaks_from_hits(src, opt, hits, t, mean, ex);
+    return peak_scan_finish(src, opt, sc, ex);
 }
 } // namespace detail
 
