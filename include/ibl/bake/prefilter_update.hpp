@@ -14,19 +14,21 @@
 //     convolved level:                    texels, the row's tail in chunks of 8, 4 and 1:
 //                                         convolve_row; a texel has S_l T_l taps, S_l samples kept
 //                                         after dropping n.l <= 0, T_l = 2 for trilinear reads, 1
-//                                         for nearest), and the last tap of a row's last chunk
-//                                         also carries the row's finish, n_l (ceil(P_l / 8) + C_l)
-//                                         taps (P_l the peaks of the fast filter's split at that
-//                                         level, bake/prefilter_peaks.hpp, eight to a tap; C_l = 1
-//                                         with a coarse tail, its read of the next level:
+//                                         for nearest); the last tap of a chunk also carries the
+//                                         chunk's finish, 4 W taps (the lanes' frames and results),
+//                                         and the last tap of a row's last chunk the row's finish,
+//                                         n_l (ceil(P_l / 5) + 2 C_l) taps (P_l the peaks of the
+//                                         fast filter's split at that level,
+//                                         bake/prefilter_peaks.hpp, five to a tap; C_l = 1 with a
+//                                         coarse tail, its bilinear read of the next level:
 //                                         whole-row operations, done once the row's texels all
 //                                         have their tap sums);
 //     the borders of a face of a          ceil(B (4 n_l + 4) / 2) taps (two border texels to a
 //     finished level:                     tap; B = 2 when a coarse tail reads the level, whose
 //                                         copy before the peaks, as_next, has its borders too,
 //                                         else 1: cubemap::update_borders(level, face)),
-// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: 16 taps, a row's
-// last tap with its finish, or a face's borders) and proportional to the taps it reports
+// so the cost of a call is bounded by max(budget, the dearest unit) (unit_taps: a chunk's last
+// tap with its finish and the row's, or a face's borders) and proportional to the taps it reports
 // (bench/bench_prefilter.cpp, BM_prefilter_update_step). Whole rows that fit go through the
 // executor; a row that does not fit is computed chunk by chunk, and a chunk's taps may span calls:
 // its lanes' accumulators (detail::lane_sums) are kept between calls, and convolve_lanes_part
@@ -51,7 +53,7 @@
 // place in the chain); unit_taps of the level that reads it counts its units too.
 //
 // A pass starts with more units. With the fast filter's peak split (bake/prefilter_peaks.hpp)
-// first the split itself: its scan of level 0, a face row per unit (1 + n taps: a texel to a tap),
+// first the split itself: its scan of level 0, a face row per unit (1 + n / 3 taps: three texels to a tap),
 // its selection of the threshold (1 + H / 2 taps, H the texels above the ratio's threshold), its
 // peaks, 64 to a unit (1 + 48 taps a peak: an exact solid angle each), and each output level's
 // merged peak list, a level per unit (1 + 8 P taps); a source whose mips do not reach 1 x 1 is
@@ -62,9 +64,12 @@
 // filter's peak split, the patch that takes the peaks out of it (1 + 8 P L taps, P peaks, L levels),
 // then, when the fast filter reconstructs rough levels from spherical harmonics
 // (bake/prefilter_sh.hpp), the projection of the packed source, a row of its level per unit
-// (1 + ceil(m B^2 / 12) taps for m texels and B bands), then the reduction of its sums (one unit). A
-// level by spherical harmonics is computed in whole rows of 16-lane chunks, 16 ceil(n_l / 16) ceil(B_l^2 / 24) taps plus the
-// row's peaks (as its finish), like a mirror level's rows.
+// (1 + ceil(m B^2 / 15) taps for m texels and B bands), then the reduction of its sums (one unit). A
+// level by spherical harmonics is computed in whole rows of 16-lane chunks, 16 ceil(n_l / 16)
+// ceil((B_l^2 + 146) / 32) taps plus the row's peaks (as its finish), like a mirror level's rows.
+// Each kind of unit's count was set so that one thread spends about the same time a tap on each
+// (2.2-2.4 ns on the VM of docs/ARCHITECTURE.md, "Dynamic probes"; the constants below give the
+// measurements).
 //
 // Time budgets. step_for(duration) runs step in slices, each given half of the time left at the
 // rate measured by the earlier slices and calls (seconds a tap, seconds_per_tap(): slices of at
@@ -354,12 +359,12 @@ private:
             while (true) {
                 const auto [x0, w] = lw.chunks[chunk_];
                 const bool last = chunk_ + 1 == lw.chunks.size();
-                const std::uint64_t lanes = std::uint64_t(w), fin = last ? lw.finish_taps : 0;
+                const std::uint64_t lanes = std::uint64_t(w), fin = lanes * lw.chunk_taps + (last ? lw.finish_taps : 0);
                 const std::uint64_t left = count - tap_, room = budget - spent;
                 std::uint64_t k = left;
                 bool complete = true;
                 if (left * lanes + fin > room) { // the taps that fit, short of the one that carries the finish
-                    k = std::min<std::uint64_t>(room / lanes, last && left > 0 ? left - 1 : left);
+                    k = std::min<std::uint64_t>(room / lanes, fin > 0 && left > 0 ? left - 1 : left);
                     complete = false;
                     if (k == 0) {
                         if (spent > 0 || !progress) {
@@ -430,8 +435,16 @@ private:
         pass_done_ = false;
     }
     /// Peak evaluations counted as one tap in the budget (bake/prefilter_peaks.hpp: about ten
-    /// vectorised float operations against a bilinear tap's rotation, face selection and reads).
-    static constexpr std::size_t peak_per_tap = 8;
+    /// vectorised float operations against a bilinear tap's rotation, face selection and reads;
+    /// measured at 0.5 ns a peak and texel against 2.3-2.6 ns a tap, one thread), and the taps of a
+    /// texel's coarse tail (a bilinear read of the next level's bordered face and a blend: 4.6-5.2
+    /// ns a texel).
+    static constexpr std::size_t peak_per_tap = 5, tail_taps_per_texel = 2;
+    /// A convolved texel's work outside its taps, counted in taps a lane of a chunk (its frame,
+    /// built by load_row_frames, and its result: a division and a store): a texel of T taps
+    /// measured at about (T + 4) times a tap's time (2.17 ns a tap and 10.7 ns a texel, from levels
+    /// of 24 and 64 taps, one thread).
+    static constexpr std::size_t chunk_taps_per_lane = 4;
     /// Border texels counted as one tap (a copy from a neighbouring face, mostly one cache line per
     /// texel along a column, against a tap's 8-12 texel reads and its arithmetic; measured by
     /// bench/bench_prefilter.cpp, BM_prefilter_update_step).
@@ -465,14 +478,12 @@ private:
         return t;
     }
     /// The split's scan: a row of level 0 (a luminance and a comparison a texel, scan_per_tap
-    /// texels a tap: the source was just copied and its level 0 is read once, from memory, so a
-    /// texel costs about a tap; 4 texels a tap took the 99th percentile of 2^20-tap calls from 1.2
-    /// to 1.6 times their budget's time, bench_prefilter BM_prefilter_update_step), its selection (a
+    /// texels a tap: 0.6-0.9 ns a texel on one thread, the source just copied), its selection (a
     /// copy and a partial sort of the texels it kept, select_per_tap of them a tap), its peaks (an
     /// exact solid angle's four atan2 and a normalisation each, about 100 ns: build_taps_per_peak
     /// taps, peak_build_unit peaks a unit) and each level's merged peak list (one to three merges of
     /// the peaks' keys by a stable sort: merge_taps_per_peak taps a peak).
-    static constexpr std::size_t scan_per_tap = 1, select_per_tap = 2, build_taps_per_peak = 48, peak_build_unit = 64,
+    static constexpr std::size_t scan_per_tap = 3, select_per_tap = 2, build_taps_per_peak = 48, peak_build_unit = 64,
                                  merge_taps_per_peak = 8;
     std::uint64_t split_row_taps() const noexcept { return 1 + (std::uint64_t(first_source_size()) + scan_per_tap - 1) / scan_per_tap; }
     std::uint64_t split_select_taps() const noexcept { return 1 + (std::uint64_t(src_->split_hits()) + select_per_tap - 1) / select_per_tap; }
@@ -498,10 +509,13 @@ private:
     /// The split's patch: a few texels per peak and level of the packed copy.
     std::uint64_t patch_taps() const noexcept { return 1 + 8 * std::uint64_t(src_->peak_count()) * std::uint64_t(source_->levels()); }
     /// Coefficients of the spherical-harmonic projection (one source texel, one (l, m): a basis
-    /// value and three multiply-adds) and of a level's reconstruction (one output texel, one (l, m))
-    /// counted as one tap (measured by bench/bench_prefilter.cpp, BM_prefilter_update_step).
-    static constexpr std::size_t sh_project_per_tap = 12;
-    static constexpr std::size_t sh_texel_per_tap = 24;
+    /// value and three multiply-adds) counted as one tap, and a level's reconstruction of an output
+    /// texel of B bands counted as (B^2 + sh_texel_base) / sh_texel_per_tap taps: its direction, the
+    /// recurrence's start and its store cost about sh_texel_base coefficients. Measured on one
+    /// thread at 2.4 ns a tap: the projection at 0.16 ns a coefficient, the reconstruction at
+    /// 0.076 ns a coefficient and 11 ns a texel (levels of 11, 13 and 24 bands).
+    static constexpr std::size_t sh_project_per_tap = 15;
+    static constexpr std::size_t sh_texel_base = 146, sh_texel_per_tap = 32;
     /// A row of the projection: n texels of B^2 coefficients (B the projection's bands).
     std::uint64_t sh_row_taps() const noexcept {
         const std::uint64_t b = std::uint64_t(src_->sh_projection_bands());
@@ -528,7 +542,8 @@ private:
         detail::prefilter_cube_level conv{}; ///< a convolved level's taps and peaks
         double tail_roughness = -1.0;        ///< >= 0: reads its coarse tail from the next level
         std::uint64_t taps_per_row = 1;      ///< n texel_taps + finish_taps (a mirror row: n)
-        std::uint64_t texel_taps = 1;        ///< a convolved texel's tap sum
+        std::uint64_t texel_taps = 1;        ///< a convolved texel's taps: its tap sum and its chunk's share
+        std::uint64_t chunk_taps = 0;        ///< a chunk's finish a lane (its frames and results), carried by the chunk's last tap
         std::uint64_t finish_taps = 0;       ///< a convolved row's finish: its tail reads and peaks
         std::uint64_t border_taps = 1;       ///< the borders of a face (of the chain, and of as_next when kept)
         std::vector<std::pair<int, int>> chunks; ///< a row's chunks of lanes (first texel, width), as convolve_row
@@ -538,7 +553,8 @@ private:
     };
     /// The dearest work unit of a level: a face's borders, a whole row, or a chunk's tap with the row's finish.
     static std::uint64_t work_unit_taps(const level_work& lw) noexcept {
-        return std::max(lw.border_taps, lw.whole_rows() ? lw.taps_per_row : std::uint64_t(lw.chunks.front().second) + lw.finish_taps);
+        return std::max(lw.border_taps, lw.whole_rows() ? lw.taps_per_row
+                                                        : std::uint64_t(lw.chunks.front().second) * (1 + lw.chunk_taps) + lw.finish_taps);
     }
     /// The taps of a whole level: its rows and its faces' borders.
     static std::uint64_t level_taps(const level_work& lw) noexcept {
@@ -547,12 +563,13 @@ private:
 
     static void set_convolved_costs(level_work& lw) noexcept {
         const std::uint64_t b = std::uint64_t(lw.conv.sh.bands);
-        lw.texel_taps = lw.conv.sh.active() ? (b * b + sh_texel_per_tap - 1) / sh_texel_per_tap
-                                            : std::max<std::uint64_t>(1, lw.conv.taps.w.size());
+        lw.chunk_taps = lw.conv.sh.active() ? 0 : chunk_taps_per_lane;
+        lw.texel_taps = lw.conv.sh.active() ? (b * b + sh_texel_base + sh_texel_per_tap - 1) / sh_texel_per_tap
+                                            : std::max<std::uint64_t>(1, lw.conv.taps.w.size()) + lw.chunk_taps;
         // a level by spherical harmonics computes its rows in chunks of 16 lanes (a row's last chunk whole)
         const std::uint64_t lanes = lw.conv.sh.active() ? std::uint64_t((lw.n + 15) / 16 * 16) : std::uint64_t(lw.n);
         lw.finish_taps = std::uint64_t(lw.n) * ((lw.conv.peaks.size() + peak_per_tap - 1) / peak_per_tap +
-                                                (lw.conv.tail_share > 0.f ? 1u : 0u));
+                                                (lw.conv.tail_share > 0.f ? tail_taps_per_texel : 0u));
         lw.taps_per_row = lanes * lw.texel_taps + lw.finish_taps;
         lw.chunks.clear();
         int x = 0;
