@@ -76,10 +76,12 @@
 // least 1024 taps move it in log space, at most 4x a slice, so a descheduled slice is forgotten
 // within a few calls), reading the clock between slices only. A slice whose true rate is within
 // 2x of the estimate ends within the time left, so the call ends within its budget unless one unit
-// alone is dearer than what is left; the rate differs by phase (a row's taps run on one thread,
-// whole rows through the executor; a row's cost depends on where its taps read) by up to 1.7x on
-// one thread, which the halving absorbs where a fixed tap budget cannot (bench/bench_prefilter.cpp,
-// BM_prefilter_update_time).
+// alone is dearer than what is left; the rate still differs by phase (a row's taps run on one
+// thread, whole rows through the executor; a row's cost depends on where its taps read), and a
+// slice that the machine stops (a virtual CPU descheduled for tens of microseconds) leaves no time
+// for the next one, so the call does no more work after the stop: the halving absorbs both where a
+// fixed tap budget cannot
+// (bench/bench_prefilter.cpp, BM_prefilter_update_time).
 //
 // Costs outside the budget: set_source (and the constructor) keeps its own copy of the source (one
 // copy of every texel, none when the source is moved in) and, for a first pass or a source of
