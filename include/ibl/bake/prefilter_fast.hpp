@@ -166,19 +166,29 @@ struct fast_radial_cdf {
     std::vector<double> theta, cdf;
     double total = 0.0;
 };
-/// The radial CDF of any kernel k(theta) >= 0 (negative values read as 0) on the grid of
-/// make_fast_radial_cdf for roughness r.
-template <class KernelFn> fast_radial_cdf make_radial_cdf_of(double roughness, KernelFn&& k) {
-    constexpr int m = 4096;
-    fast_radial_cdf c;
+/// The grid of make_fast_radial_cdf for roughness r without its leading 0: theta_i = lo (hi /
+/// lo)^(i / m), i = 0..m, lo = 1e-6 s(r), hi = pi / 2.
+inline constexpr int fast_radial_grid_steps = 4096;
+inline std::vector<double> fast_radial_grid(double roughness) {
+    constexpr int m = fast_radial_grid_steps;
     const double lo = 1e-6 * fast_lobe_scale(roughness), hi = 0.5 * pi_v<double>;
+    std::vector<double> t(std::size_t(m) + 1);
+    for (int i = 0; i <= m; ++i) t[std::size_t(i)] = lo * std::pow(hi / lo, double(i) / m);
+    return t;
+}
+/// The radial CDF of kernel values kv[i] >= 0 (negative values read as 0) at grid[i]
+/// (fast_radial_grid), with sin(grid[i]) given: the trapezoid rule in theta from theta = 0.
+inline fast_radial_cdf radial_cdf_from_values(const std::vector<double>& grid, const std::vector<double>& sin_grid,
+                                              const std::vector<double>& kv) {
+    fast_radial_cdf c;
+    c.theta.reserve(grid.size() + 1);
+    c.cdf.reserve(grid.size() + 1);
     c.theta.push_back(0.0);
     c.cdf.push_back(0.0);
     double prev_t = 0.0, prev_f = 0.0, acc = 0.0;
-    for (int i = 0; i <= m; ++i) {
-        const double t = lo * std::pow(hi / lo, double(i) / m);
-        const double kv = k(t);
-        const double f = (kv > 0.0 ? kv : 0.0) * std::sin(t);
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+        const double t = grid[i];
+        const double f = (kv[i] > 0.0 ? kv[i] : 0.0) * sin_grid[i];
         acc += 0.5 * (f + prev_f) * (t - prev_t);
         c.theta.push_back(t);
         c.cdf.push_back(acc);
@@ -187,6 +197,19 @@ template <class KernelFn> fast_radial_cdf make_radial_cdf_of(double roughness, K
     c.total = acc;
     for (double& v : c.cdf) v = acc > 0.0 ? v / acc : 0.0;
     return c;
+}
+inline std::vector<double> sin_of(const std::vector<double>& t) {
+    std::vector<double> s(t.size());
+    for (std::size_t i = 0; i < t.size(); ++i) s[i] = std::sin(t[i]);
+    return s;
+}
+/// The radial CDF of any kernel k(theta) >= 0 (negative values read as 0) on the grid of
+/// make_fast_radial_cdf for roughness r.
+template <class KernelFn> fast_radial_cdf make_radial_cdf_of(double roughness, KernelFn&& k) {
+    const std::vector<double> grid = fast_radial_grid(roughness);
+    std::vector<double> kv(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i) kv[i] = k(grid[i]);
+    return radial_cdf_from_values(grid, sin_of(grid), kv);
 }
 template <class Lobe> fast_radial_cdf make_fast_radial_cdf(double roughness, ld_weight weight) {
     return make_radial_cdf_of(roughness, [&](double t) { return fast_kernel<Lobe>(t, roughness, weight); });
@@ -233,21 +256,26 @@ struct fast_rest_kernel {
     fast_coarse_tail tail;
 };
 template <class Lobe> fast_rest_kernel make_fast_rest_kernel(double roughness, double next_roughness, ld_weight weight) {
-    const fast_radial_cdf whole = make_fast_radial_cdf<Lobe>(roughness, weight);
-    double c = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 1; i < whole.theta.size(); ++i) {
-        const double k = fast_kernel<Lobe>(whole.theta[i], roughness, weight);
-        const double kn = fast_kernel<Lobe>(whole.theta[i], next_roughness, weight);
-        if (k > 0.0 && kn > 0.0) c = std::min(c, k / kn);
+    // Each kernel once per node of the grid (the whole CDF, the bound c and the rest's CDF read
+    // the same values).
+    const std::vector<double> grid = fast_radial_grid(roughness), sin_grid = sin_of(grid);
+    std::vector<double> k(grid.size()), kn(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i) {
+        k[i] = fast_kernel<Lobe>(grid[i], roughness, weight);
+        kn[i] = fast_kernel<Lobe>(grid[i], next_roughness, weight);
     }
+    const fast_radial_cdf whole = radial_cdf_from_values(grid, sin_grid, k);
+    double c = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < grid.size(); ++i) // every node but theta = 0
+        if (k[i] > 0.0 && kn[i] > 0.0) c = std::min(c, k[i] / kn[i]);
     fast_rest_kernel r;
     if (!std::isfinite(c) || !(c > 0.0) || !(whole.total > 0.0)) {
         r.cdf = whole;
         return r;
     }
-    r.cdf = make_radial_cdf_of(roughness, [&](double t) {
-        return fast_kernel<Lobe>(t, roughness, weight) - c * fast_kernel<Lobe>(t, next_roughness, weight);
-    });
+    std::vector<double> rest(grid.size());
+    for (std::size_t i = 0; i < grid.size(); ++i) rest[i] = k[i] - c * kn[i];
+    r.cdf = radial_cdf_from_values(grid, sin_grid, rest);
     r.tail.c = c;
     r.tail.share = std::clamp(1.0 - r.cdf.total / whole.total, 0.0, 1.0);
     return r;

@@ -95,17 +95,29 @@ template <class Lobe> std::vector<double> zonal_band_factors(int count, double r
     std::vector<double> edges{0.0};
     for (double t = 0.02 * s; t < half_pi; t *= 1.4) edges.push_back(t);
     edges.push_back(half_pi);
+    // A panel's nodes side by side: the Legendre recurrence of each node is a chain of divisions,
+    // so the nodes' chains run together (vectorised) while each k_l still adds the nodes' terms
+    // one after another in node order, as a loop node by node would.
+    const std::size_t nodes = gl.x.size();
+    std::vector<double> f(nodes), mu(nodes), p0(nodes), p1(nodes);
     for (std::size_t e = 0; e + 1 < edges.size(); ++e) {
         const double a = edges[e], b = edges[e + 1];
-        for (std::size_t i = 0; i < gl.x.size(); ++i) {
+        for (std::size_t i = 0; i < nodes; ++i) {
             const double t = 0.5 * (a + b) + 0.5 * (b - a) * gl.x[i];
-            const double f = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t) * 0.5 * (b - a) * gl.w[i];
-            const double mu = std::cos(t);
-            double p0 = 1.0, p1 = mu; // P_l, P_(l+1)
-            for (std::size_t l = 0; l < k.size(); ++l) {
-                k[l] += f * p0;
-                const double p2 = ((2.0 * double(l) + 3.0) * mu * p1 - (double(l) + 1.0) * p0) / (double(l) + 2.0);
-                p0 = p1, p1 = p2;
+            f[i] = fast_kernel<Lobe>(t, roughness, weight) * std::sin(t) * 0.5 * (b - a) * gl.w[i];
+            mu[i] = std::cos(t);
+            p0[i] = 1.0; // P_l
+            p1[i] = mu[i]; // P_(l+1)
+        }
+        for (std::size_t l = 0; l < k.size(); ++l) {
+            double acc = k[l];
+            for (std::size_t i = 0; i < nodes; ++i) acc += f[i] * p0[i];
+            k[l] = acc;
+            const double c1 = 2.0 * double(l) + 3.0, c0 = double(l) + 1.0, d = double(l) + 2.0;
+            for (std::size_t i = 0; i < nodes; ++i) {
+                const double p2 = (c1 * mu[i] * p1[i] - c0 * p0[i]) / d;
+                p0[i] = p1[i];
+                p1[i] = p2;
             }
         }
     }
