@@ -222,3 +222,41 @@ TEST_CASE("prefilter_update: a time budget finishes with the one-shot chain, bit
         CHECK(same_bits(*up.result(), ref));
     }
 }
+
+TEST_CASE("prefilter_update: a source whose mips stop above 1 x 1 is split in units too, the same bits") {
+    // The split's mean then reads level 0 by texel solid angles, a face row per unit, before its
+    // scan: set_source does none of it, every call stays within max(budget, the dearest unit), and
+    // each pass equals the one-shot chain.
+    const ibl::cubemap<float> full = sky(32, 400.0f);
+    ibl::cubemap<float> part(32, 3); // 32, 16, 8: no 1 x 1 level
+    for (int f = 0; f < 6; ++f)
+        for (int y = 0; y < 32; ++y)
+            for (int x = 0; x < 32; ++x) part.set_texel(f, x, y, 0, full.texel(f, x, y, 0));
+    part.generate_mips();
+    REQUIRE(part.size(part.levels() - 1) == 8);
+    ibl::prefilter_options o;
+    o.method = ibl::prefilter_method::fast;
+    o.samples_per_level = {0, 8, 16, 32};
+    o.levels = 4;
+    const ibl::specular_chain ref = ibl::prefilter(part, o, ibl::serial_executor{});
+    for (std::uint64_t budget : {std::uint64_t(1), std::uint64_t(40), std::uint64_t(3000), ~std::uint64_t(0) / 2}) {
+        ibl::prefilter_update<> up(part, o);
+        CHECK_FALSE(up.peaks_ready()); // the split is the pass's first units, not set_source's work
+        std::uint64_t unit = up.setup_unit_taps();
+        for (std::size_t k = 0; k < up.plan().size(); ++k) unit = std::max(unit, up.unit_taps(k));
+        std::uint64_t spent = 0;
+        int calls = 0;
+        while (!up.done()) {
+            const std::uint64_t s = up.step(budget);
+            CHECK(s <= std::max(budget, unit));
+            spent += s;
+            REQUIRE(++calls < 10000000);
+        }
+        CHECK(spent == up.total_taps());
+        CHECK(same_bits(*up.result(), ref));
+    }
+    // The split found the diagonal's peaks (it is not empty), as the one-shot's.
+    ibl::prefilter_options none = o;
+    none.peaks.enabled = false;
+    CHECK_FALSE(same_bits(ref, ibl::prefilter(part, none, ibl::serial_executor{})));
+}

@@ -626,24 +626,34 @@ public:
         reset(src);
         if (splits()) set_split(find_cube_peaks(src, opt_.peaks, ex));
     }
-    /// The same with the split left to the caller too (prefilter_update): split_row every row of
-    /// split_rows(), then split_select(), then split_build every peak of split_peaks(), and the
-    /// object is the one restart makes (the same operations: the same peaks). A source whose mips
-    /// do not reach 1 x 1 is split at once (its mean needs a pass over level 0 first): split_rows()
-    /// is then 0 and the split is done.
+    /// The same with the split left to the caller too (prefilter_update): without a 1 x 1 level,
+    /// first split_mean_row every row of split_mean_rows() in order (the mean of level 0 by texel
+    /// solid angles, as find_cube_peaks sums it); then split_row every row of split_rows(), then
+    /// split_select(), then split_build every peak of split_peaks(), and the object is the one
+    /// restart makes (the same operations: the same peaks).
     void restart_deferred(const cubemap<T>& src) {
         reset(src);
         split_pending_ = scanned_ = false;
+        mean_rows_ = 0;
+        mean_acc_ = 0.0;
         hits_.clear();
         if (!splits()) return;
-        if (peak_scan_start(src, opt_.peaks, scan_)) {
-            split_pending_ = scanned_ = true;
-            scan_row_.resize(std::size_t(src.size(0)));
-            return;
+        split_pending_ = scanned_ = true;
+        scan_row_.resize(std::size_t(src.size(0)));
+        if (peak_scan_start(src, opt_.peaks, scan_)) return;
+        const int n = src.size(0);
+        if (omega_n_ != n) { // the face's texel solid angles, once per source size
+            omega_ = cube_face_solid_angles<double>(n);
+            omega_n_ = n;
         }
-        serial_executor one;
-        set_split(find_cube_peaks(src, opt_.peaks, one));
+        peak_scan_reset(opt_.peaks, n, 0.0, scan_); // the rows' slots; the threshold once the mean is known
+        mean_rows_ = std::size_t(6 * n);
     }
+    /// The rows of level 0 the mean reads before the scan (0 with a 1 x 1 level), row r added
+    /// (rows in order), and the scan's threshold from the mean after the last.
+    [[nodiscard]] std::size_t split_mean_rows() const noexcept { return mean_rows_; }
+    void split_mean_row(const cubemap<T>& src, std::size_t r) noexcept { peak_mean_row(src, omega_, r, mean_acc_); }
+    void split_mean_finish() { peak_scan_reset(opt_.peaks, scan_.n, mean_acc_ / four_pi_v<double>, scan_); }
     /// True until split_select: the scan's rows and the selection are due.
     [[nodiscard]] bool split_pending() const noexcept { return split_pending_; }
     /// The rows of this pass's scan (0 when the pass has none), and the texels it kept so far (the
@@ -836,6 +846,10 @@ private:
     std::vector<double> sh_coef_;
     bool sh_ready_ = false;
     peak_scan scan_{};            ///< the deferred split's scan (restart_deferred)
+    std::size_t mean_rows_ = 0;   ///< rows of level 0 the deferred split's mean reads first (no 1 x 1 level)
+    double mean_acc_ = 0.0;       ///< their sum so far (luminance times texel solid angle)
+    std::vector<double> omega_;   ///< a face's texel solid angles for that mean
+    int omega_n_ = 0;             ///< and the face size they are for
     std::vector<float> scan_row_; ///< its scratch row
     std::vector<std::pair<std::size_t, float>> hits_; ///< the texels the selection kept (split_build's)
     bool split_pending_ = false;  ///< the scan's rows or the selection are due

@@ -175,6 +175,15 @@ inline void peak_scan_reset(const peak_split_options& opt, int n, double mean, p
     for (auto& r : sc.rows) r.clear();
     sc.hits = 0;
 }
+/// Without a 1 x 1 level the mean comes from level 0 by texel solid angles (omega: the face's
+/// cube_face_solid_angles), summed texel by texel in texel order: peak_mean_row(r) adds face row r
+/// (face n + y) to acc, rows in order, then peak_scan_reset(opt, n, acc / 4 pi, sc).
+template <class T>
+void peak_mean_row(const cubemap<T>& src, const std::vector<double>& omega, std::size_t r, double& acc) noexcept {
+    const int n = src.size(0), f = int(r) / n, y = int(r) % n;
+    const double* w = omega.data() + std::size_t(y) * std::size_t(n);
+    for (int x = 0; x < n; ++x) acc += double(peak_texel_luminance(src, f, x, y)) * w[x];
+}
 template <class T> bool peak_scan_start(const cubemap<T>& src, const peak_split_options& opt, peak_scan& sc) {
     const int top = src.levels() - 1;
     if (src.size(top) != 1) return false;
@@ -277,10 +286,7 @@ cube_peak_split<T> find_cube_peaks(const cubemap<T>& src, const peak_split_optio
         // No 1 x 1 level: the mean of level 0 by texel solid angles first (in texel order).
         const std::vector<double> omega = cube_face_solid_angles<double>(n);
         double acc = 0.0;
-        for (int f = 0; f < 6; ++f)
-            for (int y = 0; y < n; ++y)
-                for (int x = 0; x < n; ++x)
-                    acc += double(peak_texel_luminance(src, f, x, y)) * omega[std::size_t(y) * std::size_t(n) + std::size_t(x)];
+        for (std::size_t r = 0; r < std::size_t(6 * n); ++r) peak_mean_row(src, omega, r, acc);
         peak_scan_reset(opt, n, acc / four_pi_v<double>, sc);
     }
     // One pass over level 0, each row its own.

@@ -53,11 +53,12 @@
 // place in the chain); unit_taps of the level that reads it counts its units too.
 //
 // A pass starts with more units. With the fast filter's peak split (bake/prefilter_peaks.hpp)
-// first the split itself: its scan of level 0, a face row per unit (1 + n / 3 taps: three texels to a tap),
+// first the split itself: for a source whose mips do not reach 1 x 1, the mean of level 0 by
+// texel solid angles, a face row per unit (1 + n / 2 taps; with a 1 x 1 level the mean is six
+// reads), then its scan of level 0, a face row per unit (1 + n / 3 taps: three texels to a tap),
 // its selection of the threshold (1 + H / 2 taps, H the texels above the ratio's threshold), its
 // peaks, 64 to a unit (1 + 48 taps a peak: an exact solid angle each), and each output level's
-// merged peak list, a level per unit (1 + 8 P taps); a source whose mips do not reach 1 x 1 is
-// split by set_source instead (its mean needs a pass over level 0 first). Until those units are
+// merged peak list, a level per unit (1 + 8 P taps). Until those units are
 // done, the pass's rows count no peaks: total_taps() and remaining_taps() are exact from then on
 // (peaks_ready()). Then the packed copy of the source that the taps read, a bordered row
 // of one of its levels per unit (n + 2 taps: a texel to a tap), then, with the fast
@@ -246,6 +247,7 @@ public:
     /// the projection by spherical harmonics).
     std::uint64_t setup_unit_taps() const noexcept {
         const std::uint64_t split = std::max({src_->split_rows() > 0 ? split_row_taps() : std::uint64_t(0),
+                                              src_->split_mean_rows() > 0 ? split_mean_row_taps() : std::uint64_t(0),
                                               src_->split_pending() ? split_select_taps() : std::uint64_t(0),
                                               peak_build_taps(std::min<std::size_t>(peak_build_unit, std::max(src_->split_peaks(), src_->split_pending() ? std::size_t(opt_.peaks.max_peaks) : std::size_t(0)))),
                                               level_peaks_taps()});
@@ -265,7 +267,15 @@ private:
         std::uint64_t spent = 0;
         bool stop = false;
         while (!pass_done_ && !stop && spent < budget) {
-            if (!split_selected_) { // the pass's first units: the peak split's scan, a row per unit, then its selection
+            if (!split_selected_) { // the pass's first units: the peak split's mean (without a 1 x 1 level) and scan, a row per unit, then its selection
+                if (split_mean_row_ < src_->split_mean_rows()) {
+                    const std::uint64_t c = split_mean_row_taps();
+                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    src_->split_mean_row(*source_, split_mean_row_++);
+                    if (split_mean_row_ == src_->split_mean_rows()) src_->split_mean_finish();
+                    spent += c;
+                    continue;
+                }
                 if (src_->split_pending() && split_row_ < src_->split_rows()) {
                     const std::uint64_t c = split_row_taps();
                     if ((spent > 0 || !progress) && c > budget - spent) break;
@@ -402,6 +412,7 @@ private:
         // the same storage when the shape is unchanged).
         if (!src_) src_.emplace(opt_);
         src_->restart_deferred(*source_);
+        split_mean_row_ = 0;
         split_row_ = 0;
         split_peak_ = 0;
         split_selected_ = false;
@@ -479,27 +490,31 @@ private:
         }
         return t;
     }
-    /// The split's scan: a row of level 0 (a luminance and a comparison a texel, scan_per_tap
+    /// The split's mean without a 1 x 1 level: a row of level 0 (a luminance and a multiply-add
+    /// in double a texel, in texel order: mean_per_tap texels a tap; 1.5 ns a texel, one thread,
+    /// a chain of dependent additions). Its scan: a row of level 0 (a luminance and a comparison a texel, scan_per_tap
     /// texels a tap: 0.6-0.9 ns a texel on one thread, the source just copied), its selection (a
     /// copy and a partial sort of the texels it kept, select_per_tap of them a tap), its peaks (an
     /// exact solid angle's four atan2 and a normalisation each, about 100 ns: build_taps_per_peak
     /// taps, peak_build_unit peaks a unit) and each level's merged peak list (one to three merges of
     /// the peaks' keys by a stable sort: merge_taps_per_peak taps a peak).
-    static constexpr std::size_t scan_per_tap = 3, select_per_tap = 2, build_taps_per_peak = 48, peak_build_unit = 64,
+    static constexpr std::size_t mean_per_tap = 2, scan_per_tap = 3, select_per_tap = 2, build_taps_per_peak = 48, peak_build_unit = 64,
                                  merge_taps_per_peak = 8;
     std::uint64_t split_row_taps() const noexcept { return 1 + (std::uint64_t(first_source_size()) + scan_per_tap - 1) / scan_per_tap; }
+    std::uint64_t split_mean_row_taps() const noexcept { return 1 + (std::uint64_t(first_source_size()) + mean_per_tap - 1) / mean_per_tap; }
     std::uint64_t split_select_taps() const noexcept { return 1 + (std::uint64_t(src_->split_hits()) + select_per_tap - 1) / select_per_tap; }
     static std::uint64_t peak_build_taps(std::size_t peaks) noexcept { return 1 + std::uint64_t(peaks) * build_taps_per_peak; }
     std::uint64_t level_peaks_taps() const noexcept { return 1 + std::uint64_t(src_->peak_count()) * merge_taps_per_peak; }
     int first_source_size() const noexcept { return source_ ? source_->size(0) : 1; }
     /// The split's units from the current one on (the selection and the peaks at what the scan
     /// has kept so far, at most max_peaks peaks).
-    std::uint64_t split_taps() const noexcept { return split_taps_from(split_row_, split_peak_, peaks_level_); }
+    std::uint64_t split_taps() const noexcept { return split_taps_from(split_mean_row_, split_row_, split_peak_, peaks_level_); }
     /// A whole pass's split units.
-    std::uint64_t whole_split_taps() const noexcept { return split_taps_from(0, 0, 0); }
-    std::uint64_t split_taps_from(std::size_t row, std::size_t peak, std::size_t level) const noexcept {
+    std::uint64_t whole_split_taps() const noexcept { return split_taps_from(0, 0, 0, 0); }
+    std::uint64_t split_taps_from(std::size_t mean_row, std::size_t row, std::size_t peak, std::size_t level) const noexcept {
         const bool selected = split_selected_ && row >= src_->split_rows();
-        std::uint64_t t = std::uint64_t(src_->split_rows() - std::min(src_->split_rows(), row)) * split_row_taps();
+        std::uint64_t t = std::uint64_t(src_->split_mean_rows() - std::min(src_->split_mean_rows(), mean_row)) * split_mean_row_taps();
+        t += std::uint64_t(src_->split_rows() - std::min(src_->split_rows(), row)) * split_row_taps();
         std::size_t peaks = src_->split_peaks();
         if (!selected && src_->split_rows() > 0) { // the selection, and the peaks it will keep at most
             t += split_select_taps();
@@ -750,6 +765,7 @@ private:
     std::size_t pos_ = 0, level_ = 0, row_ = 0;
     std::size_t chunk_ = 0, tap_ = 0;   ///< row_'s current chunk of lanes and its next tap (a row over several calls)
     std::size_t face_ = 0;              ///< after the level's last row: the next face whose borders to build
+    std::size_t split_mean_row_ = 0;    ///< the next row of the split's mean (a source without a 1 x 1 level)
     std::size_t split_row_ = 0;         ///< the next row of the peak split's scan (the pass's first units)
     bool split_selected_ = false;       ///< the split's selection done (or none due)
     std::size_t split_peak_ = 0;        ///< the next peak to build
