@@ -9,21 +9,21 @@
 // when it ends ("ibl-bake: prefilter ... 2345 ms"). --quiet silences both.
 //
 // pool_executor: the library's executor concept (core/executor.hpp): ex(count, fn) runs fn on
-// disjoint ranges covering [0, count). Ranges are chunks of about count / (16 threads) items
-// handed out dynamically (an atomic counter), so a slow row does not stall a thread. The library's
-// integrators make every item independent of the partition, so the output is bit-identical for
-// any thread count. The main thread takes chunks too and reports the fraction done.
+// disjoint ranges covering [0, count), through ibl::thread_executor's persistent workers (chunks
+// handed out dynamically, so a slow row does not stall a thread). The library's integrators make
+// every item independent of the partition, so the output is bit-identical for any thread count.
+// The calling thread takes chunks too and reports the fraction done.
 
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstddef>
 #include <cstdio>
-#include <exception>
-#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
+
+#include <ibl/core/executor.hpp>
 
 namespace ibl_bake {
 
@@ -106,34 +106,16 @@ public:
     template <class F> void operator()(std::size_t count, F&& fn) const {
         if (count == 0) return;
         if (progress_) progress_->next_pass();
-        const std::size_t workers = std::min<std::size_t>(threads_, count);
-        const std::size_t chunk = std::max<std::size_t>(1, count / (16 * workers));
-        std::atomic<std::size_t> next{0}, done{0};
-        std::exception_ptr error;
-        std::mutex error_mutex;
-        auto work = [&](bool main_thread) {
-            for (;;) {
-                const std::size_t b = next.fetch_add(chunk);
-                if (b >= count) break;
-                const std::size_t e = std::min(count, b + chunk);
-                try {
-                    fn(b, e);
-                } catch (...) {
-                    std::lock_guard<std::mutex> lock(error_mutex);
-                    if (!error) error = std::current_exception();
-                    next.store(count);
-                    break;
-                }
-                const std::size_t d = done.fetch_add(e - b) + (e - b);
-                if (main_thread && progress_) progress_->update(double(d) / double(count));
-            }
-        };
-        std::vector<std::thread> pool;
-        pool.reserve(workers - 1);
-        for (std::size_t k = 1; k < workers; ++k) pool.emplace_back([&work] { work(false); });
-        work(true);
-        for (auto& t : pool) t.join();
-        if (error) std::rethrow_exception(error);
+        // The library's persistent workers (ibl::thread_executor: no thread started per call; a
+        // bake makes dozens of calls, a fast prefilter tens of them within milliseconds); the
+        // calling thread takes chunks too and is the one that reports the fraction done.
+        std::atomic<std::size_t> done{0};
+        const std::thread::id caller = std::this_thread::get_id();
+        ibl::thread_executor{threads_}(count, [&](std::size_t b, std::size_t e) {
+            fn(b, e);
+            const std::size_t d = done.fetch_add(e - b) + (e - b);
+            if (progress_ && std::this_thread::get_id() == caller) progress_->update(double(d) / double(count));
+        });
         if (progress_) progress_->update(1.0);
     }
 
