@@ -547,6 +547,16 @@ inline void add_coarse_tail_row(const cubemap<float>& next, float share, int fac
     }
 }
 
+/// The face rows of level `level` of c (row r = face n + y, from its texel x = 0), taken before
+/// the work items write them in place: texel_ref marks the level's borders stale, so that flag is
+/// written here, on the calling thread, and not by the workers.
+inline std::vector<vec3<float>*> level_row_pointers(cubemap<float>& c, int level) {
+    const int n = c.size(level);
+    std::vector<vec3<float>*> rows(std::size_t(6 * n));
+    for (int r = 0; r < 6 * n; ++r) rows[std::size_t(r)] = &c.texel_ref(r / n, 0, r % n, level);
+    return rows;
+}
+
 /// A convolved level of a cubemap source: its taps, its peaks and its coarse tail's share.
 struct prefilter_cube_level {
     tap_table taps{};
@@ -896,8 +906,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
             const prefilter_level& lp = plan[k];
             const int n = out.size(int(k));
             // The rows are written in place: each work item owns whole face rows of the output.
-            std::vector<vec3<float>*> rows(std::size_t(6 * n));
-            for (int r = 0; r < 6 * n; ++r) rows[std::size_t(r)] = &out.texel_ref(r / n, 0, r % n, int(k));
+            const std::vector<vec3<float>*> rows = detail::level_row_pointers(out, int(k));
             if (lobe_mirror_limit<Lobe>() && lp.level == 0) {
                 const detail::prefilter_base_read m = detail::prefilter_base_mode(env, n, lp.trilinear);
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
@@ -912,9 +921,7 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                     const int nm = std::max(1, n / 2);
                     const detail::prefilter_cube_level lm = cs.mid_level(env, lp, rm, rn, nm, ex);
                     mid.emplace(nm, 1, detail::for_overwrite);
-                    // the rows' storage taken before the work items (texel_ref marks the borders stale)
-                    std::vector<vec3<float>*> mid_rows(std::size_t(6 * nm));
-                    for (int r = 0; r < 6 * nm; ++r) mid_rows[std::size_t(r)] = &mid->texel_ref(r / nm, 0, r % nm, 0);
+                    const std::vector<vec3<float>*> mid_rows = detail::level_row_pointers(*mid, 0);
                     ex(std::size_t(6 * nm), [&](std::size_t b, std::size_t e) {
                         for (std::size_t row = b; row < e; ++row) cs.row(lm, row, nm, mid_rows[row], nx, nullptr);
                     });
@@ -926,11 +933,10 @@ specular_chain prefilter(const Env& env, const prefilter_options& opt = {}, Exec
                 // (they are added to every level exactly, through its own kernel).
                 // Those rows go straight into the bordered cube that level reads.
                 std::optional<cubemap<float>> tail;
-                std::vector<vec3<float>*> tail_rows(std::size_t(6 * n), nullptr);
-                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0) {
+                if (k > 0 && detail::prefilter_tail_roughness<Lobe>(opt, plan, k - 1, out.size(0), true) >= 0.0)
                     tail.emplace(n, 1, detail::for_overwrite);
-                    for (int r = 0; r < 6 * n; ++r) tail_rows[std::size_t(r)] = &tail->texel_ref(r / n, 0, r % n, 0);
-                }
+                const std::vector<vec3<float>*> tail_rows =
+                    tail ? detail::level_row_pointers(*tail, 0) : std::vector<vec3<float>*>(std::size_t(6 * n), nullptr);
                 ex(std::size_t(6 * n), [&](std::size_t b, std::size_t e) {
                     for (std::size_t row = b; row < e; ++row) cs.row(lv, row, n, rows[row], nx, tail_rows[row]);
                 });

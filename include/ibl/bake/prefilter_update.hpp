@@ -266,11 +266,14 @@ private:
     template <class Executor> std::uint64_t step_units(std::uint64_t budget, Executor& ex, bool progress) {
         std::uint64_t spent = 0;
         bool stop = false;
+        // A unit of c taps does not fit: it exceeds what is left, and this is not the call's first
+        // unit (step makes progress with one unit even above the budget).
+        const auto no_room = [&](std::uint64_t c) { return (spent > 0 || !progress) && c > budget - spent; };
         while (!pass_done_ && !stop && spent < budget) {
             if (!split_selected_) { // the pass's first units: the peak split's mean (without a 1 x 1 level) and scan, a row per unit, then its selection
                 if (split_mean_row_ < src_->split_mean_rows()) {
                     const std::uint64_t c = split_mean_row_taps();
-                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    if (no_room(c)) break;
                     src_->split_mean_row(*source_, split_mean_row_++);
                     if (split_mean_row_ == src_->split_mean_rows()) src_->split_mean_finish();
                     spent += c;
@@ -278,14 +281,14 @@ private:
                 }
                 if (src_->split_pending() && split_row_ < src_->split_rows()) {
                     const std::uint64_t c = split_row_taps();
-                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    if (no_room(c)) break;
                     src_->split_row(*source_, split_row_++);
                     spent += c;
                     continue;
                 }
                 if (src_->split_pending()) {
                     const std::uint64_t c = split_select_taps();
-                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    if (no_room(c)) break;
                     src_->split_select();
                     spent += c;
                 }
@@ -295,7 +298,7 @@ private:
             if (split_peak_ < src_->split_peaks()) { // the peaks, peak_build_unit a unit
                 const std::size_t e = std::min(src_->split_peaks(), split_peak_ + peak_build_unit);
                 const std::uint64_t c = peak_build_taps(e - split_peak_);
-                if ((spent > 0 || !progress) && c > budget - spent) break;
+                if (no_room(c)) break;
                 src_->split_build(*source_, split_peak_, e);
                 split_peak_ = e;
                 spent += c;
@@ -303,7 +306,7 @@ private:
             }
             if (peaks_level_ < plan_.size()) { // each output level's merged peaks, a level per unit
                 const std::uint64_t c = level_peaks_taps();
-                if ((spent > 0 || !progress) && c > budget - spent) break;
+                if (no_room(c)) break;
                 level_work& w = levels_[peaks_level_];
                 if (!w.mirror) {
                     w.conv.peaks = src_->level_peaks(plan_[peaks_level_]);
@@ -316,13 +319,13 @@ private:
             if (!packed_) { // then the packed copy of the source, then the split's patch
                 if (pack_item_ < src_->pack_items()) {
                     const std::uint64_t c = pack_item_taps(pack_item_);
-                    if ((spent > 0 || !progress) && c > budget - spent) break;
+                    if (no_room(c)) break;
                     src_->pack(*source_, pack_item_, pack_item_ + 1);
                     ++pack_item_;
                     spent += c;
                     continue;
                 }
-                if ((spent > 0 || !progress) && patch_taps() > budget - spent) break;
+                if (no_room(patch_taps())) break;
                 serial_executor one;
                 src_->finish_packing(*source_, one);
                 packed_ = true;
@@ -330,14 +333,14 @@ private:
                 continue;
             }
             if (sh_row_ < src_->sh_rows()) { // the projection of the levels by spherical harmonics, a row per unit
-                if ((spent > 0 || !progress) && sh_row_taps() > budget - spent) break;
+                if (no_room(sh_row_taps())) break;
                 src_->sh_add_row(sh_row_++);
                 spent += sh_row_taps();
                 continue;
             }
             if (!sh_done_) { // then the reduction of its sums and the levels' coefficients, one unit
                 if (src_->sh_rows() > 0) {
-                    if ((spent > 0 || !progress) && sh_finish_taps() > budget - spent) break;
+                    if (no_room(sh_finish_taps())) break;
                     src_->sh_finish();
                     for (level_work& w : levels_) src_->sh_fill(w.conv);
                     spent += sh_finish_taps();
@@ -348,7 +351,7 @@ private:
             const level_work& lw = levels_[level_];
             const std::size_t rows_total = std::size_t(6 * lw.n);
             if (row_ == rows_total) { // the finished level's borders, a face per unit
-                if ((spent > 0 || !progress) && lw.border_taps > budget - spent) break;
+                if (no_room(lw.border_taps)) break;
                 if (lw.chain >= 0) back_->update_borders(lw.chain, int(face_));
                 if (lw.as_next) levels_[level_].as_next->update_borders(0, int(face_));
                 spent += lw.border_taps;
